@@ -1,0 +1,1 @@
+"""GLSL sources of splinevis (the top-level glsl/ folder of the repository)."""

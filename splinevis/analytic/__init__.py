@@ -1,0 +1,5 @@
+"""Analytic test surfaces with exact float64 ray casters (the foundation's first spline actor)."""
+
+from .patch import QuarticTrianglePatch, RayHits
+
+__all__ = ["QuarticTrianglePatch", "RayHits"]

@@ -1,0 +1,213 @@
+"""A single quartic Bernstein-Bezier triangle patch z = f(x, y): the analytic test surface.
+
+It proves the core (program assembly, injection, ray casting, depth compositing, effects) before the
+terrain program lands, and is exactly one terrain patch: the same restriction by blossoming
+(paper 000, eqs. (6)-(7)) and the same Newton iteration from secure starting points.
+
+The model is immutable float64 numpy and never imports VTK. :meth:`QuarticTrianglePatch.raycast` is the
+float64 twin of ``glsl/programs/analytic_patch.glsl``, step for step; with ``method="reference"`` it
+finds the first root with the robust all-roots finder instead of Newton, which is what tests compare
+the GPU against.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validation import as_float64_array, check_choice
+from ..bb import roots as _roots
+from ..bb import simplex as _simplex
+
+__all__ = ["QuarticTrianglePatch", "RayHits"]
+
+DEGREE = 4
+
+
+class RayHits:
+    """Result of a float64 ray cast: ``t`` (NaN for a miss), ``points`` (…, 3), ``normals`` (…, 3)."""
+
+    __slots__ = ("t", "points", "normals", "hit")
+
+    def __init__(self, t, points, normals):
+        self.t = t
+        self.points = points
+        self.normals = normals
+        self.hit = np.isfinite(t)
+
+
+class QuarticTrianglePatch:
+    """A quartic BB patch over a triangle in the xy-plane, as a graph surface.
+
+    Parameters
+    ----------
+    coefficients : (15,) array_like
+        BB coefficients (heights) in :func:`splinevis.bb.simplex.multi_indices` ``(4, 2)`` order.
+    vertices : (3, 2) array_like
+        The domain triangle's vertices (counter-clockwise or clockwise; must not be degenerate).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> p = QuarticTrianglePatch(np.full(15, 2.0), [[0, 0], [1, 0], [0, 1]])
+    >>> float(p.evaluate([0.25, 0.25]))
+    2.0
+    """
+
+    def __init__(self, coefficients, vertices):
+        c = as_float64_array(coefficients, "coefficients", ndim=1)
+        n_expected = (DEGREE + 1) * (DEGREE + 2) // 2
+        if c.shape != (n_expected,):
+            raise ValueError(f"coefficients of a quartic triangle patch must have shape ({n_expected},), got {c.shape}.")
+        v = as_float64_array(vertices, "vertices", ndim=2, shape_tail=(3, 2))
+        if v.shape != (3, 2):
+            raise ValueError(f"vertices must have shape (3, 2), got {v.shape}.")
+        area2 = (v[1, 0] - v[0, 0]) * (v[2, 1] - v[0, 1]) - (v[2, 0] - v[0, 0]) * (v[1, 1] - v[0, 1])
+        scale = np.ptp(v, axis=0).max()
+        if not abs(area2) > 1e-12 * scale * scale:
+            raise ValueError(f"vertices {v.tolist()} span a degenerate triangle (twice its area is {area2:g}).")
+        self._c = c.copy()
+        self._c.setflags(write=False)
+        self._v = v.copy()
+        self._v.setflags(write=False)
+        # lam = M @ (x, y, 1)
+        self._m = np.linalg.inv(np.vstack([v.T, np.ones(3)]))
+        self._m.setflags(write=False)
+
+    # -- data -----------------------------------------------------------------------------------------
+    @property
+    def coefficients(self) -> np.ndarray:
+        return self._c
+
+    @property
+    def vertices(self) -> np.ndarray:
+        return self._v
+
+    @property
+    def barycentric_matrix(self) -> np.ndarray:
+        """(3, 3) M with barycentric coordinates ``M @ (x, y, 1)``."""
+        return self._m
+
+    @property
+    def zrange(self) -> tuple:
+        """(min, max) coefficient: the surface lies in this slab (convex-hull property)."""
+        return float(self._c.min()), float(self._c.max())
+
+    @classmethod
+    def from_function(cls, func, vertices) -> "QuarticTrianglePatch":
+        """The patch interpolating ``func(x, y)`` at the 15 domain points (quartic interpolation)."""
+        v = as_float64_array(vertices, "vertices", ndim=2, shape_tail=(3, 2))
+        idx = _simplex.multi_indices(DEGREE, 2)
+        pts = (idx / DEGREE) @ v  # domain points
+        b = _simplex.bernstein_basis(DEGREE, 2, idx / DEGREE)  # (15 points, 15 basis)
+        values = np.asarray(func(pts[:, 0], pts[:, 1]), dtype=np.float64)
+        return cls(np.linalg.solve(b, values), v)
+
+    @classmethod
+    def demo(cls) -> "QuarticTrianglePatch":
+        """A saddle-and-bump patch over the triangle (-1, -1), (1.2, -0.9), (-0.2, 1.1)."""
+        return cls.from_function(
+            lambda x, y: 0.35 * np.exp(-2.0 * (x * x + y * y)) + 0.15 * x * y - 0.05 * x * x * y * y,
+            [[-1.0, -1.0], [1.2, -0.9], [-0.2, 1.1]],
+        )
+
+    # -- evaluation -----------------------------------------------------------------------------------
+    def barycentric(self, xy) -> np.ndarray:
+        xy = as_float64_array(xy, "xy", shape_tail=(2,))
+        return xy @ self._m[:, :2].T + self._m[:, 2]
+
+    def evaluate(self, xy) -> np.ndarray:
+        """f(x, y) for points (…, 2) (extrapolated outside the triangle)."""
+        return _simplex.de_casteljau(self._c, self.barycentric(xy), d=2)
+
+    def gradient(self, xy) -> np.ndarray:
+        """(…, 2) gradient (f_x, f_y) by the derivative patch along the Cartesian directions."""
+        lam = self.barycentric(xy)
+        out = []
+        for k in range(2):
+            dc = _simplex.derivative(self._c, self._m[:, k], d=2)
+            out.append(_simplex.de_casteljau(dc, lam, d=2))
+        return np.stack(out, axis=-1)
+
+    def proxy(self):
+        """The prism over the triangle between the coefficient extremes: (6, 3) points, (8, 3) triangles
+        oriented outward."""
+        zlo, zhi = self.zrange
+        if zhi - zlo < 1e-9 * max(1.0, abs(zhi)):
+            pad = 1e-6 * max(1.0, abs(zhi))  # a flat patch still needs a prism with volume
+            zlo, zhi = zlo - pad, zhi + pad
+        v = self._v
+        if np.cross(v[1] - v[0], v[2] - v[0]) < 0:
+            v = v[[0, 2, 1]]
+        pts = np.vstack([np.c_[v, np.full(3, zlo)], np.c_[v, np.full(3, zhi)]])
+        tris = np.array([[0, 2, 1], [3, 4, 5],
+                         [0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [2, 0, 3], [2, 3, 5]])
+        return pts, tris
+
+    # -- float64 twin of glsl/programs/analytic_patch.glsl ------------------------------------------------
+    def raycast(self, origins, directions, tmin=0.0, *, method: str = "reference", iterations: int = 6) -> RayHits:
+        """Intersect rays with the patch in float64.
+
+        Parameters
+        ----------
+        origins, directions : (…, 3) array_like
+            Rays ``o + t d``; directions need not be unit.
+        tmin : float or (…) array_like
+            Smallest admissible t (0 for perspective rays starting at the eye, -inf for parallel rays).
+        method : {"reference", "newton"}
+            ``"newton"`` mirrors the shader (secure-start Newton, ``iterations`` steps);
+            ``"reference"`` takes the first root from the robust all-roots finder.
+
+        Returns
+        -------
+        RayHits
+        """
+        check_choice(method, "method", {"reference", "newton"})
+        o = as_float64_array(origins, "origins", shape_tail=(3,))
+        d = as_float64_array(directions, "directions", shape_tail=(3,))
+        o, d = np.broadcast_arrays(o, d)
+        tmin = np.broadcast_to(np.asarray(tmin, dtype=np.float64), o.shape[:-1])
+        m = self._m
+        lam_o = o[..., :2] @ m[:, :2].T + m[:, 2]
+        lam_d = d[..., :2] @ m[:, :2].T
+        t0 = tmin.copy()
+        t1 = np.full(o.shape[:-1], np.inf)
+        miss = np.zeros(o.shape[:-1], dtype=bool)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for i in range(3):
+                flat = np.abs(lam_d[..., i]) < 1e-30
+                miss |= flat & (lam_o[..., i] < 0)
+                tc = -lam_o[..., i] / lam_d[..., i]
+                t0 = np.where(~flat & (lam_d[..., i] > 0), np.maximum(t0, tc), t0)
+                t1 = np.where(~flat & (lam_d[..., i] < 0), np.minimum(t1, tc), t1)
+            zlo, zhi = self.zrange
+            flat = np.abs(d[..., 2]) < 1e-30
+            miss |= flat & ((o[..., 2] < zlo) | (o[..., 2] > zhi))
+            ta = (zlo - o[..., 2]) / d[..., 2]
+            tb = (zhi - o[..., 2]) / d[..., 2]
+            t0 = np.where(flat, t0, np.maximum(t0, np.minimum(ta, tb)))
+            t1 = np.where(flat, t1, np.minimum(t1, np.maximum(ta, tb)))
+        miss |= ~(t0 <= t1)
+        t0 = np.where(miss, 0.0, t0)
+        t1 = np.where(miss, 0.0, t1)
+        l0 = lam_o + t0[..., None] * lam_d
+        l1 = lam_o + t1[..., None] * lam_d
+        c = _simplex.restrict_to_segment(self._c, l0, l1, d=2)
+        z0 = o[..., 2] + t0 * d[..., 2]
+        z1 = o[..., 2] + t1 * d[..., 2]
+        k = np.arange(DEGREE + 1) / DEGREE
+        c = c - (z0[..., None] * (1 - k) + z1[..., None] * k)
+        if method == "newton":
+            s = _roots.newton_secure(c, iterations=iterations)
+        else:
+            s = _roots.first_root_reference(c)
+        s = np.where(miss, np.nan, s)
+        t = t0 + s * (t1 - t0)
+        pts = o + t[..., None] * d
+        hit = np.isfinite(t)
+        normals = np.full(pts.shape, np.nan)
+        if hit.any():
+            g = self.gradient(pts[hit][:, :2])
+            pts[hit, 2] = self.evaluate(pts[hit][:, :2])
+            normals[hit] = np.c_[-g, np.ones(len(g))]
+        return RayHits(t, pts, normals)

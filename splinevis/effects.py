@@ -1,0 +1,224 @@
+"""The Style object: which effects a scene declares, as data.
+
+A :class:`Style` decides two things, kept apart on purpose:
+
+* **code** -- which effect files are compiled into a program (:meth:`Style.effect_set`, :meth:`Style.defines`,
+  :meth:`Style.include_files`). This is part of the program cache key: two styles with the same effect
+  set share one compiled program.
+* **parameters** -- colours, light directions, stripe frequencies, colormap ranges (:meth:`Style.uniforms`).
+  They are uniforms; changing them never recompiles.
+
+Effects (each lives in ``glsl/lib/effects/<name>.glsl`` and is compiled in only when declared):
+
+============== ===================================================================================
+lights          number of directional lights, 0..4 (0 = unlit base colour); diffuse Lambert terms
+specular        Phong specular term on every light
+colormap        base colour from the surface scalar (height for terrains) through a matplotlib colormap
+texture         base colour from an RGB(A) image draped by the surface's (u, v)
+environment     reflection of a latitude-longitude environment image
+reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray
+isophotes       stripes of constant ``dot(n, L)``
+normals         output colour = encoded unit normal ``0.5 * (n + 1)`` (replaces shading)
+curvature       output colour = mean curvature through a diverging colormap (replaces shading)
+depth           output colour = window depth in the red channel (replaces shading)
+============== ===================================================================================
+
+``normals``, ``curvature`` and ``depth`` are output modes: at most one of them may be declared.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+import numpy as np
+
+from ._validation import as_float64_array, check_choice
+
+__all__ = ["Style", "EFFECTS", "OUTPUT_MODES", "MAX_LIGHTS"]
+
+MAX_LIGHTS = 4
+OUTPUT_MODES = ("normals", "curvature", "depth")
+#: effect name -> (GLSL flag, include file). 'lights' and 'specular' share the lighting file.
+EFFECTS: dict[str, tuple[str, str]] = {
+    "lights": ("SV_NUM_LIGHTS", "lib/effects/lights.glsl"),
+    "specular": ("SV_SPECULAR", "lib/effects/lights.glsl"),
+    "colormap": ("SV_COLORMAP", "lib/effects/colormap.glsl"),
+    "texture": ("SV_TEXTURE", "lib/effects/texture.glsl"),
+    "environment": ("SV_ENVIRONMENT", "lib/effects/environment.glsl"),
+    "reflection_lines": ("SV_REFLECTION_LINES", "lib/effects/reflection_lines.glsl"),
+    "isophotes": ("SV_ISOPHOTES", "lib/effects/isophotes.glsl"),
+    "normals": ("SV_OUT_NORMALS", "lib/effects/normals.glsl"),
+    "curvature": ("SV_OUT_CURVATURE", "lib/effects/curvature.glsl"),
+    "depth": ("SV_OUT_DEPTH", "lib/effects/depth.glsl"),
+}
+
+# Default light rig: a headlight slightly above-left and a weaker fill, given in camera coordinates
+# (x right, y up, z towards the viewer) as directions *towards* the light.
+_DEFAULT_LIGHTS = ((-0.3, 0.5, 1.0), (0.6, -0.2, 0.8), (0.0, 1.0, 0.2), (-1.0, 0.0, 0.3))
+
+
+def _rgb(value, name):
+    if isinstance(value, str):
+        from matplotlib.colors import to_rgb
+
+        try:
+            return tuple(float(c) for c in to_rgb(value))
+        except ValueError:
+            raise ValueError(f"{name} {value!r} is not a colour name matplotlib knows (e.g. 'tan', '#c0a080').") from None
+    arr = as_float64_array(value, name, ndim=1, shape_tail=(3,))
+    if arr.min() < 0 or arr.max() > 1:
+        raise ValueError(f"{name} must have RGB components in [0, 1], got {tuple(arr)}.")
+    return tuple(float(c) for c in arr)
+
+
+@dataclass(frozen=True)
+class Style:
+    """How a spline actor is shaded; only the declared effects are compiled in.
+
+    Parameters
+    ----------
+    lights : int, default 1
+        Number of directional lights (0..4), fixed relative to the camera.
+    specular : bool, default False
+        Add a Phong specular term (needs ``lights >= 1``).
+    color : str or (3,) float, default "tan"
+        Base colour when neither ``colormap`` nor ``texture`` is declared.
+    colormap : str, optional
+        Name of a matplotlib colormap: colour by the surface scalar (height for terrains).
+    scalar_range : (float, float), optional
+        Scalar values mapped to the ends of the colormap; defaults to the model's range.
+    texture : (H, W, 3|4) uint8 ndarray, optional
+        Image draped over the surface's parameter domain (u, v in [0, 1]).
+    environment : (H, W, 3) uint8 ndarray, optional
+        Latitude-longitude environment image, reflected by the surface.
+    reflection_lines : int, optional
+        Number of parallel light lines (reflection-line stripes) across the field of view.
+    isophotes : int, optional
+        Number of isophote bands of ``dot(n, L)`` for the first light direction.
+    output : {"normals", "curvature", "depth"}, optional
+        Replace shading by an analysis output.
+    ambient, diffuse, specular_power : float
+        Lighting parameters (uniforms; changing them does not recompile).
+    curvature_scale : float, default 1.0
+        Mean curvature shown at full colour by ``output="curvature"`` (a uniform).
+
+    Examples
+    --------
+    >>> from splinevis import Style
+    >>> s = Style(lights=2, specular=True, reflection_lines=12)
+    >>> sorted(s.effect_set())
+    ['lights', 'reflection_lines', 'specular']
+    >>> Style(lights=2).effect_set() == Style(lights=2, color="red").effect_set()
+    True
+    """
+
+    lights: int = 1
+    specular: bool = False
+    color: Any = "tan"
+    colormap: str | None = None
+    scalar_range: tuple | None = None
+    texture: Any = field(default=None, compare=False, hash=False)
+    environment: Any = field(default=None, compare=False, hash=False)
+    reflection_lines: int | None = None
+    isophotes: int | None = None
+    output: str | None = None
+    ambient: float = 0.15
+    diffuse: float = 0.85
+    specular_power: float = 40.0
+    curvature_scale: float = 1.0
+
+    def __post_init__(self):
+        if isinstance(self.lights, bool) or not isinstance(self.lights, (int, np.integer)) or not 0 <= self.lights <= MAX_LIGHTS:
+            raise ValueError(f"Style.lights must be an integer in 0..{MAX_LIGHTS}, got {self.lights!r}.")
+        if self.specular and self.lights == 0:
+            raise ValueError("Style.specular=True needs at least one light; set lights >= 1.")
+        object.__setattr__(self, "color", _rgb(self.color, "Style.color"))
+        if self.colormap is not None:
+            import matplotlib
+
+            if self.colormap not in matplotlib.colormaps:
+                raise ValueError(f"Style.colormap {self.colormap!r} is not a matplotlib colormap (e.g. 'viridis', 'terrain').")
+        if self.colormap is not None and self.texture is not None:
+            raise ValueError("Style: declare either colormap or texture as the base colour, not both.")
+        if self.scalar_range is not None:
+            lo, hi = as_float64_array(self.scalar_range, "Style.scalar_range", ndim=1, shape_tail=(2,))
+            if not hi > lo:
+                raise ValueError(f"Style.scalar_range must be (low, high) with low < high, got {self.scalar_range!r}.")
+        for name in ("texture", "environment"):
+            img = getattr(self, name)
+            if img is not None:
+                arr = np.asarray(img)
+                if arr.ndim != 3 or arr.shape[2] not in (3, 4) or arr.dtype != np.uint8:
+                    raise ValueError(f"Style.{name} must be an (H, W, 3 or 4) uint8 image, got {arr.dtype} {arr.shape}.")
+        for name in ("reflection_lines", "isophotes"):
+            v = getattr(self, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1):
+                raise ValueError(f"Style.{name} must be a positive integer count of stripes, got {v!r}.")
+        if self.isophotes is not None and self.lights == 0:
+            raise ValueError("Style.isophotes are bands of dot(n, L) for the first light: set lights >= 1.")
+        if self.output is not None:
+            check_choice(self.output, "Style.output", OUTPUT_MODES)
+
+    # -- code -----------------------------------------------------------------------------------------
+    def effect_set(self) -> frozenset:
+        """The names of the declared effects: what decides the compiled code."""
+        on = set()
+        if self.lights:
+            on.add("lights")
+        if self.specular:
+            on.add("specular")
+        if self.colormap is not None:
+            on.add("colormap")
+        for name in ("texture", "environment", "reflection_lines", "isophotes"):
+            if getattr(self, name) is not None:
+                on.add(name)
+        if self.output is not None:
+            on.add(self.output)
+        return frozenset(on)
+
+    def defines(self) -> dict:
+        """Compile-time flags for the declared effects (``SV_NUM_LIGHTS`` carries the count)."""
+        out = {}
+        for name in self.effect_set():
+            flag = EFFECTS[name][0]
+            out[flag] = self.lights if name == "lights" else True
+        return out
+
+    def include_files(self) -> list[str]:
+        """The effect files to include, without duplicates, in a stable order."""
+        files = []
+        for name in EFFECTS:
+            if name in self.effect_set() and EFFECTS[name][1] not in files:
+                files.append(EFFECTS[name][1])
+        return files
+
+    # -- parameters -----------------------------------------------------------------------------------
+    def light_directions_camera(self) -> np.ndarray:
+        """(lights, 3) unit directions towards each light in camera coordinates."""
+        d = np.asarray(_DEFAULT_LIGHTS[: self.lights], dtype=np.float64).reshape(-1, 3)
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+    def uniforms(self) -> dict:
+        """Scalar and vector uniforms (name -> float or tuple); set without recompiling."""
+        u = {"sv_color": self.color, "sv_ambient": float(self.ambient), "sv_diffuse": float(self.diffuse)}
+        if self.specular:
+            u["sv_specular_power"] = float(self.specular_power)
+        if self.reflection_lines is not None:
+            u["sv_stripes"] = float(self.reflection_lines)
+        if self.isophotes is not None:
+            u["sv_isophote_bands"] = float(self.isophotes)
+        if self.colormap is not None and self.scalar_range is not None:
+            u["sv_scalar_range"] = tuple(float(v) for v in self.scalar_range)
+        if self.output == "curvature":
+            u["sv_curvature_scale"] = float(self.curvature_scale)
+        return u
+
+    def replace(self, **changes) -> "Style":
+        """A copy with some fields changed (styles are immutable)."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        unknown = set(changes) - set(values)
+        if unknown:
+            raise TypeError(f"Style has no field(s) {sorted(unknown)}; fields are {sorted(values)}.")
+        values.update(changes)
+        return Style(**values)

@@ -1,0 +1,185 @@
+"""GLSL program assembly: ``#include`` resolution, compile-time flags, a cache, and line origins.
+
+Shader code lives in small files under ``glsl/`` (shipped as ``splinevis.glsl``). A file pulls in another
+with ``#include "lib/bernstein.glsl"`` (path relative to the ``glsl/`` root). Each file is included at
+most once per program, so files can include what they use without guards. Compile-time flags become
+``#define`` lines at the top; effects and program variants are selected with ``#ifdef`` in the files,
+so code of an effect that a scene does not declare never reaches the driver.
+
+The same assembled text serves VTK (spliced into vtkOpenGLPolyDataMapper's template by
+:mod:`splinevis.gl.inject`) and moderngl (:mod:`splinevis.gl.harness`); both wrap it with their own
+``#version`` line. Every output line remembers the file and line it came from, so a compile error can be
+reported against ``glsl/lib/roots.glsl:42`` rather than line 731 of VTK's expanded program.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+from ..errors import ShaderIncludeError
+
+__all__ = ["Assembled", "assemble", "glsl_root", "BEGIN_MARKER"]
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*(//.*)?$')
+_DEFINE_NAME = re.compile(r"^[A-Z_][A-Z0-9_]*$")
+#: First line of every assembled block; lets us find our code inside VTK's expanded program.
+BEGIN_MARKER = "// splinevis:begin "
+
+
+def glsl_root() -> Path:
+    """The directory holding the shipped GLSL sources (``glsl/`` in the repository)."""
+    return Path(str(importlib.resources.files("splinevis.glsl")))
+
+
+@dataclass(frozen=True)
+class Assembled:
+    """An assembled GLSL block.
+
+    Attributes
+    ----------
+    name : str
+        The entry file (or ``"<string>"``).
+    defines : tuple of (str, str)
+        The compile-time flags, sorted; part of the cache key.
+    text : str
+        The source: marker line, ``#define`` lines, then the files in include order.
+    origins : tuple of (str, int)
+        For each line of ``text``, the ``glsl/``-relative file and 1-based line it came from
+        (``("<defines>", 0)`` for generated lines).
+    files : tuple of str
+        The files that were included, in order (what a test inspects to prove an effect was left out).
+    """
+
+    name: str
+    defines: tuple
+    text: str
+    origins: tuple
+    files: tuple
+
+    def origin_in(self, full_source: str):
+        """Return a function mapping a 1-based line of ``full_source`` (which contains ``text``) to
+        ``"file:line"`` or None for lines outside our block."""
+        lines = full_source.splitlines()
+        marker = self.text.splitlines()[0]
+        try:
+            start = lines.index(marker)
+        except ValueError:
+            start = None
+
+        def origin(lineno: int):
+            if start is None:
+                return None
+            k = lineno - 1 - start
+            if 0 <= k < len(self.origins):
+                f, ln = self.origins[k]
+                return f"{f}:{ln}"
+            return None
+
+        return origin
+
+
+def _format_define(name: str, value) -> str:
+    if not isinstance(name, str) or not _DEFINE_NAME.match(name):
+        raise ValueError(
+            f"GLSL flag name {name!r} is not valid: use upper-case letters, digits and '_' "
+            "(e.g. 'SV_NUM_LIGHTS')."
+        )
+    if value is True or value is None:
+        return f"#define {name} 1"
+    if value is False:
+        return ""  # a false flag is simply absent, so #ifdef sees it as off
+    if isinstance(value, int):
+        return f"#define {name} {value}"
+    if isinstance(value, float):
+        return f"#define {name} {value!r}"
+    raise TypeError(f"GLSL flag {name} must be bool, int or float, got {type(value).__name__} {value!r}.")
+
+
+def _read(root: Path, rel: str, chain: tuple) -> list[str]:
+    path = root / rel
+    if not path.is_file():
+        where = f" (included from {chain[-1]})" if chain else ""
+        raise ShaderIncludeError(
+            f"GLSL file {rel!r}{where} not found under {root}. Include paths are relative to the glsl/ "
+            "folder, e.g. #include \"lib/bernstein.glsl\"."
+        )
+    return path.read_text().splitlines()
+
+
+def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: Path | None = None) -> Assembled:
+    """Assemble a GLSL block from ``entry`` with compile-time ``defines``.
+
+    Parameters
+    ----------
+    entry : str
+        A path under ``glsl/`` such as ``"programs/analytic_patch.frag.glsl"``, or GLSL source text
+        (anything containing a newline is taken as text; its includes are resolved the same way).
+    defines : mapping of str to bool, int or float, optional
+        Compile-time flags. ``True`` and ints become ``#define NAME value``; ``False`` leaves the flag
+        undefined.
+    root : Path, optional
+        Another GLSL root (tests use a temporary one). Defaults to :func:`glsl_root`.
+
+    Returns
+    -------
+    Assembled
+        Cached: the same ``(entry, defines, root)`` returns the same object.
+
+    Examples
+    --------
+    >>> from splinevis.gl.assembler import assemble
+    >>> block = assemble('#include "lib/bernstein.glsl"\\n', {"SV_DEGREE": 4})
+    >>> "lib/bernstein.glsl" in block.files
+    True
+    >>> "#define SV_DEGREE 4" in block.text
+    True
+    """
+    key = tuple(sorted((defines or {}).items()))
+    for name, value in key:
+        _format_define(name, value)  # validate before the cache so bad flags always raise
+    return _assemble_cached(entry, key, str(root) if root is not None else None)
+
+
+@functools.lru_cache(maxsize=256)
+def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
+    root = Path(root_str) if root_str is not None else glsl_root()
+    is_text = "\n" in entry
+    name = "<string>" if is_text else entry
+    out: list[str] = [BEGIN_MARKER + name]
+    origins: list[tuple] = [("<marker>", 0)]
+    for n, v in key:
+        line = _format_define(n, v)
+        if line:
+            out.append(line)
+            origins.append(("<defines>", 0))
+    seen: list[str] = []
+
+    def expand(lines: list[str], rel: str, chain: tuple):
+        for i, line in enumerate(lines, start=1):
+            m = _INCLUDE.match(line)
+            if not m:
+                out.append(line)
+                origins.append((rel, i))
+                continue
+            target = m.group(1)
+            if target in chain:
+                cycle = " -> ".join(chain + (target,))
+                raise ShaderIncludeError(f"GLSL include cycle: {cycle}. Remove one of these #include lines.")
+            if target in seen:
+                continue
+            seen.append(target)
+            out.append(f"// --- {target}")
+            origins.append((target, 0))
+            expand(_read(root, target, chain + (rel,)), target, chain + (target,))
+
+    if is_text:
+        expand(entry.splitlines(), "<string>", ())
+    else:
+        seen.append(entry)
+        expand(_read(root, entry, ()), entry, (entry,))
+    return Assembled(name=name, defines=key, text="\n".join(out) + "\n", origins=tuple(origins), files=tuple(seen))

@@ -1,0 +1,321 @@
+"""The one place that injects splinevis programs into VTK's vtkOpenGLPolyDataMapper.
+
+A spline program is described by a :class:`ProgramSpec` (plain data: a GLSL entry file, a proxy mesh,
+uniforms, float textures, vertex attributes). :func:`make_actor` turns it and a :class:`~splinevis.Style`
+into a VTK actor whose fragment shader ray-casts the spline:
+
+* vertex shader: passes the model-space position of the proxy vertex (``svPosMC``) and any vertex
+  attributes on to the fragment shader;
+* fragment shader: declarations + the assembled block (program file, lib files, declared effects) go in
+  at ``//VTK::Normal::Dec``; the ray cast, ``discard`` on a miss and ``gl_FragDepth`` replace
+  ``//VTK::Depth::Impl``; VTK's lighting at ``//VTK::Light::Impl`` is replaced by ``sv_shade``;
+* per frame, an ``UpdateShaderEvent`` observer sets the camera (eye, view direction, projection type),
+  the light directions and every uniform of the spec and the style;
+* the proxy is drawn with front faces culled, so fragments lie on its far side and the camera may be
+  inside it;
+* VBO shift/scale is off, so ``vertexMC`` holds real model coordinates.
+
+Facts this relies on were measured on this machine (../shared/notes/vtk-headless-and-shader-injection.md)
+and are checked by tests/test_inject.py.
+"""
+
+from __future__ import annotations
+
+import re
+import numpy as np
+
+from ..effects import Style
+from ..errors import ShaderCompileError
+from .assembler import Assembled, assemble
+from .spec import ProgramSpec
+
+from vtkmodules.vtkCommonCore import VTK_OBJECT
+
+__all__ = ["ProgramSpec", "SplineActor", "make_actor", "capture_vtk_errors"]
+
+_VS_DEC = """//VTK::Normal::Dec
+out vec3 svPosMC;
+"""
+_VS_IMPL = """//VTK::Normal::Impl
+  svPosMC = vertexMC.xyz;
+"""
+_FS_DEC = """//VTK::Normal::Dec
+in vec3 svPosMC;
+uniform mat4 MCDCMatrix;
+"""
+_FS_DEPTH = """
+  vec3 sv_ro; vec3 sv_rd; float sv_tmin;
+  sv_pixel_ray(svPosMC, sv_ro, sv_rd, sv_tmin);
+  SvHit sv_hit;
+  if (!sv_surface_hit(sv_ro, sv_rd, sv_tmin, sv_hit)) discard;
+  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_ro + sv_hit.t * sv_rd);
+  gl_FragDepth = sv_hit.depth;
+  vec4 sv_out = sv_shade(sv_hit, sv_rd);
+"""
+_FS_LIGHT = """  fragOutput0 = sv_out;
+"""
+
+
+def _set_uniform(program, name: str, value) -> None:
+    if isinstance(value, (bool, np.bool_)):
+        program.SetUniformi(name, int(value))
+    elif isinstance(value, (int, np.integer)):
+        program.SetUniformi(name, int(value))
+    elif isinstance(value, (float, np.floating)):
+        program.SetUniformf(name, float(value))
+    else:
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim == 1 and arr.size in (2, 3, 4) and not name.endswith("[]"):
+            getattr(program, f"SetUniform{arr.size}f")(name, tuple(arr.tolist()))
+        elif arr.ndim == 1:
+            program.SetUniform1fv(name.rstrip("[]"), int(arr.size), arr.astype(np.float32).tolist())
+        elif arr.ndim == 2 and arr.shape[1] in (2, 3, 4):
+            base = name.rstrip("[]")
+            for i, row in enumerate(arr):
+                getattr(program, f"SetUniform{arr.shape[1]}f")(f"{base}[{i}]", tuple(row.tolist()))
+        else:
+            raise ValueError(f"uniform {name}: cannot set a value of shape {arr.shape}.")
+
+
+def _float_texture(array: np.ndarray, name: str):
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkRenderingCore import vtkTexture
+
+    arr = np.ascontiguousarray(array, dtype=np.float32)
+    if arr.ndim != 3 or arr.shape[2] != 4:
+        raise ValueError(f"texture {name} must be (H, W, 4) float32, got {arr.shape}.")
+    h, w, _ = arr.shape
+    img = vtkImageData()
+    img.SetDimensions(w, h, 1)
+    vtk_arr = numpy_to_vtk(arr.reshape(-1, 4), deep=True)
+    vtk_arr.SetName(name)
+    img.GetPointData().SetScalars(vtk_arr)
+    tex = vtkTexture()
+    tex.SetInputData(img)
+    tex.SetColorModeToDirectScalars()  # keep float values: an RGBA32F texture
+    tex.InterpolateOff()
+    tex.MipmapOff()
+    tex.RepeatOff()
+    tex.EdgeClampOn()
+    return tex
+
+
+def _image_texture(image: np.ndarray, *, interpolate: bool, repeat: bool = False):
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkRenderingCore import vtkTexture
+
+    arr = np.ascontiguousarray(image[::-1])  # image rows run top-down, texture rows bottom-up
+    h, w, c = arr.shape
+    img = vtkImageData()
+    img.SetDimensions(w, h, 1)
+    img.GetPointData().SetScalars(numpy_to_vtk(arr.reshape(-1, c), deep=True))
+    tex = vtkTexture()
+    tex.SetInputData(img)
+    tex.SetColorModeToDirectScalars()
+    tex.SetInterpolate(bool(interpolate))
+    tex.SetRepeat(bool(repeat))
+    tex.EdgeClampOn() if not repeat else None
+    return tex
+
+
+def _colormap_image(name: str) -> np.ndarray:
+    import matplotlib
+
+    rgba = matplotlib.colormaps[name](np.linspace(0.0, 1.0, 256))
+    return (rgba[None, :, :] * 255 + 0.5).astype(np.uint8)
+
+
+class capture_vtk_errors:
+    """Context manager collecting the text VTK sends to its output window (errors and warnings).
+
+    VTK reports a failed shader compile on its output window and carries on rendering; this is how we
+    turn that into a Python exception.
+    """
+
+    def __enter__(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+
+        self._window = vtkStringOutputWindow()
+        self._previous = vtkOutputWindow.GetInstance()
+        vtkOutputWindow.SetInstance(self._window)
+        return self
+
+    def __exit__(self, *exc):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
+
+        vtkOutputWindow.SetInstance(self._previous)
+        self.text = self._window.GetOutput() or ""
+        return False
+
+
+_NUMBERED = re.compile(r"^(\d+): ?(.*)$")
+
+
+def raise_for_shader_errors(text: str, assembled: Assembled | None = None) -> None:
+    """Raise :class:`ShaderCompileError` if ``text`` (VTK's output) reports a shader compile/link failure."""
+    if "vtkShaderProgram" not in text or not re.search(r"error", text, re.IGNORECASE):
+        return
+    source_lines, log_lines = [], []
+    for raw in text.splitlines():
+        body = raw.split("): ", 1)[1] if "vtkShaderProgram (" in raw and "): " in raw else raw
+        m = _NUMBERED.match(body)
+        if m and not re.match(r"^\d+:\d+\(\d+\)", body):
+            source_lines.append(m.group(2))
+        elif re.search(r"In vtk\w+\.cxx, line", body):
+            continue
+        elif re.search(r"\d+:\d+\(\d+\):|error|ERROR", body):
+            log_lines.append(body.strip())
+    source = "\n".join(source_lines)
+    stage = "fragment" if "fragOutput0" in source else ("vertex" if "gl_Position" in source else "unknown")
+    origin = assembled.origin_in(source) if assembled is not None and source else None
+    raise ShaderCompileError("\n".join(log_lines), source, stage, origin)
+
+
+class SplineActor:
+    """A VTK actor ray-casting a spline program, and what it knows about its compiled program.
+
+    Attributes
+    ----------
+    actor : vtkActor
+        Add it to a renderer (``plotter.add_actor``) like any other actor.
+    assembled : Assembled
+        The fragment block handed to VTK (inspect ``.text`` and ``.files``).
+    program_sources : dict
+        After the first render: ``{"vertex": ..., "fragment": ...}``, the final sources VTK compiled
+        (captured from the program object itself).
+    program_ids : set of str
+        Addresses of the vtkShaderProgram objects used; equal ids mean a shared compiled program.
+    """
+
+    def __init__(self, spec: ProgramSpec, style: Style, renderer=None, *, cull_front: bool = True):
+        from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+        from vtkmodules.vtkCommonCore import vtkCommand, vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+        from vtkmodules.vtkRenderingCore import vtkActor
+        from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
+
+        self.spec = spec
+        self.style = style
+        self.renderer = renderer
+        defines = dict(spec.defines)
+        defines.update(style.defines())
+        entry = "".join(f'#include "{f}"\n' for f in style.include_files())
+        entry += '#include "lib/shading.glsl"\n' + f'#include "{spec.entry}"\n'
+        # Effect functions must precede lib/shading.glsl which calls them; lib/raycast.glsl (SvHit)
+        # must precede everything, so it goes first.
+        entry = '#include "lib/raycast.glsl"\n' + entry
+        self.assembled = assemble(entry, defines)
+
+        points = np.asarray(spec.points, dtype=np.float64)
+        tris = np.asarray(spec.triangles, dtype=np.int64)
+        poly = vtkPolyData()
+        pts = vtkPoints()
+        pts.SetDataTypeToDouble()
+        pts.SetData(numpy_to_vtk(points, deep=True))
+        poly.SetPoints(pts)
+        cells = vtkCellArray()
+        offsets = np.arange(0, 3 * len(tris) + 1, 3, dtype=np.int64)
+        cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(tris.ravel(), deep=True))
+        poly.SetPolys(cells)
+
+        mapper = vtkOpenGLPolyDataMapper()
+        mapper.SetInputData(poly)
+        mapper.ScalarVisibilityOff()
+        mapper.SetVBOShiftScaleMethod(0)  # DISABLE_SHIFT_SCALE: vertexMC must be model coordinates
+        vs_dec, vs_impl = _VS_DEC, _VS_IMPL
+        fs_dec = _FS_DEC
+        for name, values in spec.attributes.items():
+            arr = np.asarray(values, dtype=np.float32)
+            if arr.ndim == 1:
+                arr = arr[:, None]
+            k = arr.shape[1]
+            if arr.shape[0] != len(points) or not 1 <= k <= 4:
+                raise ValueError(f"vertex attribute {name} must be (N, 1..4) with N = {len(points)} proxy points, got {arr.shape}.")
+            vtype = "float" if k == 1 else f"vec{k}"
+            vtk_arr = numpy_to_vtk(arr, deep=True)
+            vtk_arr.SetName(name)
+            poly.GetPointData().AddArray(vtk_arr)
+            mapper.MapDataArrayToVertexAttribute(name, name, 0, -1)
+            vs_dec += f"in {vtype} {name};\nflat out {vtype} {name}VSOut;\n"
+            vs_impl += f"  {name}VSOut = {name};\n"
+            fs_dec += f"flat in {vtype} {name}VSOut;\n"
+        self.mapper = mapper
+
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        prop = actor.GetProperty()
+        if cull_front:
+            prop.FrontfaceCullingOn()
+        sp = actor.GetShaderProperty()
+        sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
+        sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)
+        sp.AddFragmentShaderReplacement("//VTK::Normal::Dec", True, fs_dec + self.assembled.text, False)
+        sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, _FS_DEPTH, False)
+        sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
+        self._textures = {}
+        for name, arr in spec.textures.items():
+            self._textures[name] = _float_texture(arr, name)
+        if style.colormap is not None:
+            self._textures["sv_colormap_tex"] = _image_texture(_colormap_image(style.colormap), interpolate=True)
+        if style.texture is not None:
+            self._textures["sv_texture_tex"] = _image_texture(np.asarray(style.texture), interpolate=True)
+        if style.environment is not None:
+            self._textures["sv_environment_tex"] = _image_texture(np.asarray(style.environment), interpolate=True, repeat=True)
+        for name, tex in self._textures.items():
+            prop.SetTexture(name, tex)
+        self.actor = actor
+        self.program_sources: dict = {}
+        self.program_ids: set = set()
+        self.extra_uniforms: dict = {}
+        mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
+
+    # VTK passes the vtkShaderProgram as call data; the decorator tells the wrapper its type.
+    def _on_update_shader(self, caller, event, program=None):
+        if program is None:
+            return
+        self.program_ids.add(program.GetAddressAsString("vtkShaderProgram"))
+        if not self.program_sources:
+            self.program_sources = {
+                "vertex": program.GetVertexShader().GetSource(),
+                "fragment": program.GetFragmentShader().GetSource(),
+            }
+        for name, value in self.frame_uniforms().items():
+            _set_uniform(program, name, value)
+
+    _on_update_shader.CallDataType = VTK_OBJECT
+
+    def camera_frame(self):
+        """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera."""
+        cam = self.renderer.GetActiveCamera()
+        eye = np.array(cam.GetPosition(), dtype=np.float64)
+        focal = np.array(cam.GetFocalPoint(), dtype=np.float64)
+        view = focal - eye
+        view /= np.linalg.norm(view)
+        m = cam.GetViewTransformMatrix()
+        rot = np.array([[m.GetElement(i, j) for j in range(3)] for i in range(3)])  # camera-from-world
+        return eye, view, bool(cam.GetParallelProjection()), rot.T
+
+    def frame_uniforms(self) -> dict:
+        """All uniforms for the next frame: camera, lights, spec, style and extras."""
+        u = {}
+        if self.renderer is not None:
+            eye, view, parallel, world_from_cam = self.camera_frame()
+            u["sv_eye_mc"] = eye
+            u["sv_view_dir_mc"] = view
+            u["sv_parallel"] = int(parallel)
+            if self.style.lights:
+                dirs = self.style.light_directions_camera() @ world_from_cam.T
+                u["sv_light_dir[]"] = dirs
+            if self.spec.frame_uniforms is not None:
+                u.update(self.spec.frame_uniforms(eye, view))
+        u.update(self.spec.uniforms)
+        u.update(self.style.uniforms())
+        u.update(self.extra_uniforms)
+        return u
+
+
+def make_actor(spec: ProgramSpec, style: Style | None = None, renderer=None) -> SplineActor:
+    """Build a :class:`SplineActor` for ``spec`` shaded with ``style`` (default ``Style()``)."""
+    return SplineActor(spec, style if style is not None else Style(), renderer)

@@ -1,0 +1,48 @@
+"""ProgramSpec: what a GPU program needs, as plain arrays. No VTK here, so model code can build specs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["ProgramSpec"]
+
+
+@dataclass(frozen=True)
+class ProgramSpec:
+    """Everything a GPU program needs, as plain arrays (no VTK objects).
+
+    Attributes
+    ----------
+    name : str
+        Program name (part of the cache key), e.g. ``"analytic_patch"``.
+    entry : str
+        GLSL file under ``glsl/`` defining ``sv_surface_hit``.
+    points : (N, 3) float64 ndarray
+        Proxy vertices in model coordinates (the proxy must enclose the surface).
+    triangles : (M, 3) int ndarray
+        Proxy triangles, outward oriented.
+    defines : dict
+        Program-specific compile-time flags (the Style adds the effect flags).
+    uniforms : dict
+        name -> float, int, tuple of 2..4 floats, or 1-D array (set element-wise as ``name[i]``).
+    textures : dict
+        name -> (H, W, 4) float32 array, bound as an RGBA32F ``sampler2D`` read with ``texelFetch``.
+    attributes : dict
+        name -> (N, k <= 4) float array per proxy vertex; declared ``in`` in the vertex shader and
+        forwarded to the fragment shader as ``<name>VSOut`` (flat).
+    frame_uniforms : callable, optional
+        ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    """
+
+    name: str
+    entry: str
+    points: np.ndarray
+    triangles: np.ndarray
+    defines: dict = field(default_factory=dict)
+    uniforms: dict = field(default_factory=dict)
+    textures: dict = field(default_factory=dict)
+    attributes: dict = field(default_factory=dict)
+    frame_uniforms: Callable | None = None

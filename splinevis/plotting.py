@@ -1,0 +1,166 @@
+"""splinevis.Plotter: a pyvista.Plotter that also takes spline models, ray-cast per pixel.
+
+Importing this module selects the headless OpenGL backend (:func:`splinevis.gl.headless.configure`)
+before VTK makes its first window.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import fields
+
+import numpy as np
+
+from .effects import Style
+from .gl import headless
+
+headless.configure()
+
+import pyvista as pv  # noqa: E402  (after configure: VTK reads the window class at first window)
+
+from .gl.inject import SplineActor, capture_vtk_errors, raise_for_shader_errors  # noqa: E402
+
+__all__ = ["Plotter", "register_program"]
+
+#: model type -> function(model, **options) -> ProgramSpec. Spline packages register themselves.
+_PROGRAMS: dict = {}
+
+
+def register_program(model_type, builder) -> None:
+    """Make :meth:`Plotter.add_spline` accept models of ``model_type`` using ``builder``."""
+    _PROGRAMS[model_type] = builder
+
+
+def _builder_for(model):
+    if not _PROGRAMS:
+        from .analytic import QuarticTrianglePatch
+        from .analytic.program import patch_program
+
+        register_program(QuarticTrianglePatch, patch_program)
+    for cls in type(model).__mro__:
+        if cls in _PROGRAMS:
+            return _PROGRAMS[cls]
+    known = ", ".join(sorted(c.__name__ for c in _PROGRAMS))
+    raise TypeError(f"add_spline cannot draw a {type(model).__name__}; it draws: {known}.")
+
+
+def _style_from(style, style_kwargs) -> Style:
+    names = {f.name for f in fields(Style)}
+    unknown = [k for k in style_kwargs if k not in names]
+    if unknown:
+        hints = []
+        for k in unknown:
+            close = difflib.get_close_matches(k, names, n=1)
+            hints.append(f"{k!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        raise TypeError(f"unknown effect or style option {', '.join(hints)}; known: {', '.join(sorted(names))}.")
+    if style is None:
+        return Style(**style_kwargs)
+    if not isinstance(style, Style):
+        raise TypeError(f"style must be a splinevis.Style, got {type(style).__name__}.")
+    return style.replace(**style_kwargs) if style_kwargs else style
+
+
+class Plotter(pv.Plotter):
+    """A :class:`pyvista.Plotter` with :meth:`add_spline`; everything else is PyVista's.
+
+    Anti-aliasing is off unless asked for: the ray-cast programs shade each pixel once, and exact
+    readback (depth, colours) and timings need single-sample buffers.
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> import splinevis
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> pl = splinevis.Plotter(off_screen=True, window_size=(320, 240))
+    >>> actor = pl.add_spline(QuarticTrianglePatch.demo(), reflection_lines=10)
+    >>> _ = pl.add_mesh(pv.Sphere(radius=0.3, center=(0, 0, 0.1)), color="steelblue")
+    >>> image = pl.screenshot()
+    >>> image.shape
+    (240, 320, 3)
+    """
+
+    _gl_checked = False
+    _spline_actors: tuple = ()
+
+    def __init__(self, *args, anti_aliasing: bool = False, **kwargs):
+        super().__init__(*args, **kwargs)
+        if not anti_aliasing:
+            self.disable_anti_aliasing()
+            self.render_window.SetMultiSamples(0)  # before the first render: single-sample buffers
+        self._spline_actors: list[SplineActor] = []
+        self._gl_checked = False
+
+    def add_spline(self, model, style: Style | None = None, *, name: str | None = None, newton_iterations: int = 6,
+                   **style_options) -> SplineActor:
+        """Add a spline model, ray-cast per pixel, beside any ordinary meshes.
+
+        Parameters
+        ----------
+        model
+            A spline model (e.g. :class:`splinevis.analytic.QuarticTrianglePatch`).
+        style : Style, optional
+            Effects and their parameters; keyword options (``lights=2``, ``reflection_lines=12``, …)
+            build or amend it. Only the declared effects are compiled in.
+        name : str, optional
+            Actor name (as in :meth:`pyvista.Plotter.add_actor`).
+        newton_iterations : int, default 6
+            Fixed Newton step count of the root finder, 1..8.
+
+        Returns
+        -------
+        SplineActor
+            Holds the VTK actor (``.actor``), the assembled GLSL (``.assembled``) and, after the first
+            render, the compiled sources (``.program_sources``).
+        """
+        st = _style_from(style, style_options)
+        spec = _builder_for(model)(model, newton_iterations=newton_iterations)
+        spline = SplineActor(spec, st, self.renderer)
+        self.add_actor(spline.actor, name=name, reset_camera=True)
+        self._spline_actors.append(spline)
+        return spline
+
+    def render(self) -> None:
+        """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`."""
+        with capture_vtk_errors() as cap:
+            super().render()
+        self._after_render(cap.text)
+
+    def render_now(self) -> None:
+        """Render the window immediately and wait for the GL pipeline (what benchmarks time)."""
+        if self._first_time:
+            self.show(auto_close=False)
+        with capture_vtk_errors() as cap:
+            self.render_window.Render()
+            self.render_window.WaitForCompletion()
+        self._after_render(cap.text)
+
+    def _after_render(self, text: str) -> None:
+        if "vtkShaderProgram" in text:
+            # Map line numbers back to glsl/ files through the actor whose block is in the failed source.
+            owner = next((s.assembled for s in self._spline_actors if s.assembled.text.splitlines()[0] in text), None)
+            raise_for_shader_errors(text, owner)
+        if not self._gl_checked and self.render_window is not None and not self._first_time:
+            headless.check_render_window(self.render_window)
+            self._gl_checked = True
+
+    def depth_buffer(self) -> np.ndarray:
+        """Window depth in [0, 1] per pixel, (H, W), row 0 at the top like :meth:`screenshot`.
+
+        Read straight from the framebuffer (pyvista's ``get_image_depth`` would reset the clipping range).
+        """
+        w, h = self.window_size
+        from vtkmodules.vtkCommonCore import vtkFloatArray
+
+        arr = vtkFloatArray()
+        self.render_window.GetZbufferData(0, 0, w - 1, h - 1, arr)
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        return vtk_to_numpy(arr).reshape(h, w)[::-1].astype(np.float64)
+
+    def camera_matrix(self) -> np.ndarray:
+        """(4, 4) float64 world -> normalized device coordinates of the active camera at this window's
+        aspect ratio (the matrix VTK's shaders use, in double precision)."""
+        w, h = self.window_size
+        cam = self.renderer.GetActiveCamera()
+        m = cam.GetCompositeProjectionTransformMatrix(w / h, -1, 1)
+        return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
