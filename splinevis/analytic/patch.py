@@ -129,6 +129,29 @@ class QuarticTrianglePatch:
             out.append(_simplex.de_casteljau(dc, lam, d=2))
         return np.stack(out, axis=-1)
 
+    def triangulate(self, k: int):
+        """The linear mesh users draw today: the triangle split into k*k sub-triangles, vertices on the
+        surface. Returns (points (M, 3), triangles (k*k, 3))."""
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"k must be a positive integer (k*k triangles), got {k!r}.")
+        k = int(k)
+        i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+        keep = i + j <= k
+        i, j = i[keep], j[keep]
+        lam = np.stack([k - i - j, i, j], axis=-1) / k
+        xy = lam @ self._v
+        pts = np.c_[xy, _simplex.de_casteljau(self._c, lam, d=2)]
+        index = -np.ones((k + 1, k + 1), dtype=np.int64)
+        index[i, j] = np.arange(len(i))
+        a, b = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+        up = a + b <= k - 1
+        a1, b1 = a[up], b[up]
+        tris = [np.stack([index[a1, b1], index[a1 + 1, b1], index[a1, b1 + 1]], axis=-1)]
+        dn = a + b <= k - 2
+        a2, b2 = a[dn], b[dn]
+        tris.append(np.stack([index[a2 + 1, b2], index[a2 + 1, b2 + 1], index[a2, b2 + 1]], axis=-1))
+        return pts, np.concatenate(tris)
+
     def proxy(self):
         """The prism over the triangle between the coefficient extremes: (6, 3) points, (8, 3) triangles
         oriented outward."""
@@ -137,7 +160,8 @@ class QuarticTrianglePatch:
             pad = 1e-6 * max(1.0, abs(zhi))  # a flat patch still needs a prism with volume
             zlo, zhi = zlo - pad, zhi + pad
         v = self._v
-        if np.cross(v[1] - v[0], v[2] - v[0]) < 0:
+        e1, e2 = v[1] - v[0], v[2] - v[0]
+        if e1[0] * e2[1] - e1[1] * e2[0] < 0:
             v = v[[0, 2, 1]]
         pts = np.vstack([np.c_[v, np.full(3, zlo)], np.c_[v, np.full(3, zhi)]])
         tris = np.array([[0, 2, 1], [3, 4, 5],

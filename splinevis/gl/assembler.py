@@ -4,7 +4,11 @@ Shader code lives in small files under ``glsl/`` (shipped as ``splinevis.glsl``)
 with ``#include "lib/bernstein.glsl"`` (path relative to the ``glsl/`` root). Each file is included at
 most once per program, so files can include what they use without guards. Compile-time flags become
 ``#define`` lines at the top; effects and program variants are selected with ``#ifdef`` in the files,
-so code of an effect that a scene does not declare never reaches the driver.
+so code of an effect that a scene does not declare never reaches the driver. The assembler itself
+resolves conditionals on ``SV_`` flags (``#ifdef SV_X``, ``#ifndef``, ``#if defined(SV_X) && ...``,
+``#elif``, ``#else``, ``#endif``): disabled branches are dropped from the text, so the source handed to
+the driver -- and kept for inspection -- holds no code of an undeclared effect. Conditionals on other
+names pass through to the GLSL preprocessor untouched.
 
 The same assembled text serves VTK (spliced into vtkOpenGLPolyDataMapper's template by
 :mod:`splinevis.gl.inject`) and moderngl (:mod:`splinevis.gl.harness`); both wrap it with their own
@@ -100,6 +104,71 @@ def _format_define(name: str, value) -> str:
     raise TypeError(f"GLSL flag {name} must be bool, int or float, got {type(value).__name__} {value!r}.")
 
 
+_COND = re.compile(r"^\s*#\s*(ifdef|ifndef|if|elif|else|endif)\b\s*(.*?)\s*(//.*)?$")
+_SV_EXPR = re.compile(r"^(?:\s|!|&&|\|\||\(|\)|defined\s*\(\s*SV_[A-Z0-9_]*\s*\)|defined\s+SV_[A-Z0-9_]*)*$")
+
+
+def _eval_condition(kind: str, expr: str, defined: set):
+    """True/False for a condition on SV_ flags only, None when it involves anything else."""
+    if kind in ("ifdef", "ifndef"):
+        name = expr.strip()
+        if not name.startswith("SV_"):
+            return None
+        return (name in defined) == (kind == "ifdef")
+    if not expr or not _SV_EXPR.match(expr):
+        return None
+    py = re.sub(r"defined\s*\(\s*(SV_[A-Z0-9_]*)\s*\)|defined\s+(SV_[A-Z0-9_]*)",
+                lambda m: str((m.group(1) or m.group(2)) in defined), expr)
+    py = py.replace("&&", " and ").replace("||", " or ").replace("!", " not ")
+    return bool(eval(py, {"__builtins__": {}}, {}))  # noqa: S307 - only True/False/and/or/not/parens remain
+
+
+def _strip_sv_conditionals(lines, origins, defined: set, name: str):
+    """Drop branches of SV_ conditionals that are off; keep everything else (and other conditionals)."""
+    out, out_origins = [], []
+    stack = []  # entries: [ours, active_now, taken_before, parent_active]
+    active = True
+    for line, origin in zip(lines, origins):
+        m = _COND.match(line)
+        if m:
+            kind, expr = m.group(1), m.group(2)
+            if kind in ("ifdef", "ifndef", "if"):
+                value = _eval_condition(kind, expr, defined)
+                if value is None:
+                    stack.append([False, active, False, active])
+                else:
+                    stack.append([True, active and value, value, active])
+                    active = active and value
+                    continue
+            elif kind in ("elif", "else", "endif"):
+                if not stack:
+                    raise ValueError(f"GLSL #{kind} without #if in {origin[0]}:{origin[1]} ({name})")
+                top = stack[-1]
+                if top[0]:
+                    if kind == "endif":
+                        stack.pop()
+                        active = top[3]
+                        continue
+                    value = True if kind == "else" else _eval_condition("if", expr, defined)
+                    if value is None:
+                        raise ValueError(
+                            f"GLSL #elif {expr} at {origin[0]}:{origin[1]} mixes SV_ flags with other names "
+                            "after an #if on SV_ flags; split the conditional."
+                        )
+                    take = value and not top[2]
+                    top[2] = top[2] or value
+                    active = top[3] and take
+                    continue
+                if kind == "endif":
+                    stack.pop()
+        if active:
+            out.append(line)
+            out_origins.append(origin)
+    if stack:
+        raise ValueError(f"GLSL conditional not closed with #endif in {name}")
+    return out, out_origins
+
+
 def _read(root: Path, rel: str, chain: tuple) -> list[str]:
     path = root / rel
     if not path.is_file():
@@ -182,4 +251,6 @@ def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
     else:
         seen.append(entry)
         expand(_read(root, entry, ()), entry, (entry,))
+    defined = {n for n, v in key if v is not False}
+    out, origins = _strip_sv_conditionals(out, origins, defined, name)
     return Assembled(name=name, defines=key, text="\n".join(out) + "\n", origins=tuple(origins), files=tuple(seen))

@@ -1,5 +1,5 @@
 // Base colour from the surface scalar through a colormap stored as a 256x1 RGBA texture.
-uniform sampler2D sv_colormap_tex;
+// The sampler (sv_colormap_tex) is declared by VTK, which binds the texture set on the actor property.
 uniform vec2 sv_scalar_range;
 
 vec3 sv_colormap(float s) {

@@ -1,5 +1,5 @@
 // Reflection of a latitude-longitude environment image (z up): direction -> (longitude, latitude).
-uniform sampler2D sv_environment_tex;
+// The sampler (sv_environment_tex) is declared by VTK, which binds the texture set on the actor property.
 
 vec3 sv_environment(vec3 r) {
     r = normalize(r);

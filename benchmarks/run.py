@@ -1,0 +1,155 @@
+"""Benchmark runner: frame times measured side by side in one run; JSON + markdown table out.
+
+    python benchmarks/run.py [--out DIR] [--repeats N] [--quick]
+
+Cases
+-----
+* ``raycast_vs_mesh``: the analytic quartic patch ray-cast per pixel against PyVista meshes of the same
+  surface with 10^3 .. 10^6 triangles, same camera, 800x600, anti-aliasing off.
+* ``effect_sets``: frame time of the ray-cast patch under each effect set (only the declared effects
+  are compiled in, so the cost of an effect is the difference to the baseline).
+
+Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
+render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
+measurements from the same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+WINDOW = (800, 600)
+
+
+def _time_frames(pl, repeats):
+    pl.render_now()  # warm-up: compiles the program, uploads buffers
+    pl.render_now()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        pl.render_now()
+        times.append(time.perf_counter() - t0)
+    return {"min_ms": 1e3 * min(times), "median_ms": 1e3 * statistics.median(times), "repeats": repeats}
+
+
+def _scene(style=None, mesh=None):
+    import pyvista as pv
+
+    from splinevis.analytic import QuarticTrianglePatch
+    from splinevis.plotting import Plotter
+    from splinevis.studies.demo import CAMERA
+
+    patch = QuarticTrianglePatch.demo()
+    pl = Plotter(off_screen=True, window_size=WINDOW)
+    if mesh is None:
+        pl.add_spline(patch, **(style or {}))
+    else:
+        pts, tris = patch.triangulate(mesh)
+        faces = np.c_[np.full(len(tris), 3), tris].ravel()
+        pl.add_mesh(pv.PolyData(pts, faces), color="tan", smooth_shading=True)
+    pl.camera_position = CAMERA
+    pl.reset_camera()
+    pl.camera.zoom(1.25)
+    return pl
+
+
+def bench_raycast_vs_mesh(repeats, quick):
+    ks = [32, 100, 316] + ([] if quick else [1000])
+    rows = []
+    pl = _scene(dict(lights=1))
+    r = _time_frames(pl, repeats)
+    pl.close()
+    rows.append({"renderer": "ray-cast quartic patch (per pixel)", "triangles": 0, **r})
+    for k in ks:
+        pl = _scene(mesh=k)
+        r = _time_frames(pl, repeats)
+        pl.close()
+        rows.append({"renderer": f"PyVista mesh k={k}", "triangles": k * k, **r})
+    base = rows[0]["median_ms"]
+    for row in rows:
+        row["ratio_to_raycast"] = row["median_ms"] / base
+    return rows
+
+
+def bench_effect_sets(repeats, quick):
+    from splinevis.studies.demo import _checker, _sky
+
+    sets = [
+        ("unlit", dict(lights=0)),
+        ("1 light", dict(lights=1)),
+        ("4 lights", dict(lights=4)),
+        ("4 lights + specular", dict(lights=4, specular=True)),
+        ("colormap", dict(lights=1, colormap="viridis")),
+        ("texture", dict(lights=1, texture=_checker())),
+        ("environment", dict(lights=1, environment=_sky())),
+        ("reflection lines", dict(lights=1, reflection_lines=10)),
+        ("isophotes", dict(lights=1, isophotes=8)),
+        ("normals", dict(output="normals")),
+        ("curvature", dict(output="curvature")),
+        ("everything", dict(lights=4, specular=True, colormap="viridis", environment=_sky(), reflection_lines=10,
+                            isophotes=8)),
+    ]
+    if quick:
+        sets = sets[:2] + sets[7:9]
+    rows = []
+    for name, style in sets:
+        pl = _scene(style)
+        r = _time_frames(pl, repeats)
+        effects = sorted(pl._spline_actors[0].style.effect_set())
+        pl.close()
+        rows.append({"effect_set": name, "effects": effects, **r})
+    base = rows[0]["median_ms"]
+    for row in rows:
+        row["ratio_to_unlit"] = row["median_ms"] / base
+    return rows
+
+
+def _markdown(results):
+    lines = [f"# splinevis benchmarks\n\n{results['machine']}\n"]
+    lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
+    lines.append("| renderer | triangles | min ms | median ms | median / ray-cast |")
+    lines.append("|---|---:|---:|---:|---:|")
+    for r in results["raycast_vs_mesh"]:
+        lines.append(f"| {r['renderer']} | {r['triangles']:,} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_raycast']:.2f} |")
+    lines.append("\n## Effect sets on the ray-cast patch\n")
+    lines.append("| effect set | compiled effects | min ms | median ms | median / unlit |")
+    lines.append("|---|---|---:|---:|---:|")
+    for r in results["effect_sets"]:
+        lines.append(f"| {r['effect_set']} | {', '.join(r['effects']) or '-'} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_unlit']:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default="out/bench")
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--quick", action="store_true", help="fewer configurations (smoke run)")
+    args = ap.parse_args(argv)
+    from tqdm import tqdm
+
+    from splinevis.gl.headless import gl_info
+
+    info = gl_info()
+    results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
+                          f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    for name, fn in tqdm([("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets)], desc="benchmarks"):
+        results[name] = fn(args.repeats, args.quick)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "results.json").write_text(json.dumps(results, indent=2))
+    md = _markdown(results)
+    (out / "results.md").write_text(md)
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,87 @@
+"""The ``splinevis`` command: ``info``, ``selftest``, ``demo``.
+
+Exit codes: 0 success, 1 the job ran and failed (selftest over its bounds), 2 bad usage, 3 no OpenGL.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+__all__ = ["main"]
+
+
+def _cmd_info(args) -> int:
+    from .gl.headless import gl_info
+
+    info = gl_info(args.backend)
+    try:
+        from .gl.harness import context_info
+
+        info["moderngl"] = context_info()
+    except Exception as exc:  # noqa: BLE001 - reported, and the exit code says it
+        info["moderngl"] = f"unavailable: {exc}"
+        print(json.dumps(info, indent=2))
+        return 3
+    print(json.dumps(info, indent=2))
+    return 0
+
+
+def _cmd_selftest(args) -> int:
+    from .selftest import run_selftest
+
+    report = run_selftest(args.out, cases=args.cases, seed=args.seed, progress=not args.quiet)
+    rows = report["functions"] if "functions" in report else report
+    failed = [r for r in _rows(rows) if not r.get("pass", False)]
+    print(f"selftest: {len(_rows(rows)) - len(failed)} of {len(_rows(rows))} functions within their bounds; "
+          f"report in {Path(args.out) / 'selftest.json'}")
+    for r in failed:
+        print(f"  FAILED {r.get('function', r.get('name'))}: max error {r.get('max_error')} > bound {r.get('bound')}")
+    return 1 if failed else 0
+
+
+def _rows(rows):
+    if isinstance(rows, dict):
+        return [dict(v, function=k) if isinstance(v, dict) else {"function": k, "pass": bool(v)} for k, v in rows.items()]
+    return list(rows)
+
+
+def _cmd_demo(args) -> int:
+    from .studies.demo import render_showcase
+
+    written = render_showcase(args.out, progress=not args.quiet)
+    for name, path in written.items():
+        print(f"{name}: {path}")
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="splinevis", description="Exact per-pixel rendering of spline models.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("info", help="print the OpenGL vendor, renderer, version and VTK window class")
+    p.add_argument("--backend", choices=["egl", "osmesa"], default=None, help="force a headless backend")
+    p.set_defaults(func=_cmd_info)
+    p = sub.add_parser("selftest", help="run the GLSL-vs-float64 numeric harness")
+    p.add_argument("--out", required=True, help="directory for selftest.json")
+    p.add_argument("--cases", type=int, default=100_000, help="random inputs per function (default 100000)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_selftest)
+    p = sub.add_parser("demo", help="render the showcase figures")
+    p.add_argument("--out", required=True, help="directory for the PNG figures")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_demo)
+    args = parser.parse_args(argv)
+    from .errors import OpenGLUnavailableError
+
+    try:
+        return args.func(args)
+    except OpenGLUnavailableError as exc:
+        print(f"splinevis: {exc}", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,56 @@
+"""Style: effect sets decide code, parameters are uniforms; bad input is named (no GPU needed)."""
+
+import numpy as np
+import pytest
+
+from splinevis import Style
+from splinevis.effects import EFFECTS
+
+
+def test_effect_set_and_defines_follow_declarations():
+    s = Style(lights=3, specular=True, colormap="viridis", reflection_lines=8)
+    assert s.effect_set() == {"lights", "specular", "colormap", "reflection_lines"}
+    assert s.defines() == {"SV_NUM_LIGHTS": 3, "SV_SPECULAR": True, "SV_COLORMAP": True, "SV_REFLECTION_LINES": True}
+    assert s.include_files() == ["lib/effects/lights.glsl", "lib/effects/colormap.glsl", "lib/effects/reflection_lines.glsl"]
+
+
+def test_unlit_style_declares_nothing():
+    assert Style(lights=0).effect_set() == frozenset()
+    assert Style(lights=0).include_files() == []
+
+
+def test_parameters_do_not_change_the_effect_set():
+    a = Style(lights=2, color="red", ambient=0.3)
+    b = Style(lights=2, color=(0.1, 0.2, 0.3), ambient=0.1)
+    assert a.effect_set() == b.effect_set() and a.defines() == b.defines()
+    assert a.uniforms()["sv_color"] == (1.0, 0.0, 0.0)
+
+
+def test_every_effect_has_a_file_and_a_flag():
+    from splinevis.gl.assembler import glsl_root
+
+    for name, (flag, path) in EFFECTS.items():
+        assert flag.startswith("SV_")
+        assert (glsl_root() / path).is_file(), name
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(lights=5), r"lights must be an integer in 0..4, got 5"),
+    (dict(lights=0, specular=True), "needs at least one light"),
+    (dict(colormap="no_such_map"), "'no_such_map' is not a matplotlib colormap"),
+    (dict(color="notacolour"), "'notacolour' is not a colour name"),
+    (dict(color=(2.0, 0.0, 0.0)), r"RGB components in \[0, 1\]"),
+    (dict(color=(np.nan, 0.0, 0.0)), "finite"),
+    (dict(output="wireframe"), "output 'wireframe' is not known"),
+    (dict(reflection_lines=0), "positive integer"),
+    (dict(texture=np.zeros((4, 4), np.uint8)), r"\(H, W, 3 or 4\) uint8"),
+    (dict(scalar_range=(1.0, 0.0)), "low < high"),
+])
+def test_bad_style_input_is_named(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        Style(**kwargs)
+
+
+def test_replace_rejects_unknown_fields():
+    with pytest.raises(TypeError, match=r"no field\(s\) \['reflection'\]"):
+        Style().replace(reflection=3)
