@@ -56,8 +56,7 @@ def _scene(style=None, mesh=None):
         faces = np.c_[np.full(len(tris), 3), tris].ravel()
         pl.add_mesh(pv.PolyData(pts, faces), color="tan", smooth_shading=True)
     pl.camera_position = CAMERA
-    pl.reset_camera()
-    pl.camera.zoom(1.25)
+    pl.reset_camera_clipping_range()
     return pl
 
 

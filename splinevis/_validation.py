@@ -42,7 +42,7 @@ def check_finite(arr: np.ndarray, name: str) -> None:
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
         count = int(bad.sum())
         raise ValueError(
-            f"{name} must have finite values; found {count} non-finite, the first {arr[idx]!r} at index {idx}."
+            f"{name} must have finite values; found {count} non-finite, the first {float(arr[idx])!r} at index {idx}."
         )
 
 

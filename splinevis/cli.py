@@ -18,9 +18,10 @@ def _cmd_info(args) -> int:
 
     info = gl_info(args.backend)
     try:
-        from .gl.harness import context_info
+        from .gl.harness import get_context
 
-        info["moderngl"] = context_info()
+        ctx = get_context()
+        info["moderngl"] = {k: ctx.info[k] for k in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")}
     except Exception as exc:  # noqa: BLE001 - reported, and the exit code says it
         info["moderngl"] = f"unavailable: {exc}"
         print(json.dumps(info, indent=2))
@@ -81,6 +82,9 @@ def main(argv=None) -> int:
     except OpenGLUnavailableError as exc:
         print(f"splinevis: {exc}", file=sys.stderr)
         return 3
+    except (ValueError, TypeError) as exc:
+        print(f"splinevis: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

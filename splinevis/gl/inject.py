@@ -7,7 +7,7 @@ into a VTK actor whose fragment shader ray-casts the spline:
 * vertex shader: passes the model-space position of the proxy vertex (``svPosMC``) and any vertex
   attributes on to the fragment shader;
 * fragment shader: declarations + the assembled block (program file, lib files, declared effects) go in
-  at ``//VTK::Normal::Dec``; the ray cast, ``discard`` on a miss and ``gl_FragDepth`` replace
+  at ``//VTK::Edges::Dec`` (after VTK's texture samplers); the ray cast, ``discard`` on a miss and ``gl_FragDepth`` replace
   ``//VTK::Depth::Impl``; VTK's lighting at ``//VTK::Light::Impl`` is replaced by ``sv_shade``;
 * per frame, an ``UpdateShaderEvent`` observer sets the camera (eye, view direction, projection type),
   the light directions and every uniform of the spec and the style;
@@ -39,7 +39,10 @@ out vec3 svPosMC;
 _VS_IMPL = """//VTK::Normal::Impl
   svPosMC = vertexMC.xyz;
 """
-_FS_DEC = """//VTK::Normal::Dec
+# Inserted at the last declaration tag of VTK's template, after VTK has declared the samplers of the
+# textures set on the actor property (effects use them).
+_FS_DEC_TAG = "//VTK::Edges::Dec"
+_FS_DEC = """//VTK::Edges::Dec
 in vec3 svPosMC;
 uniform mat4 MCDCMatrix;
 """
@@ -251,7 +254,7 @@ class SplineActor:
         sp = actor.GetShaderProperty()
         sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
         sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)
-        sp.AddFragmentShaderReplacement("//VTK::Normal::Dec", True, fs_dec + self.assembled.text, False)
+        sp.AddFragmentShaderReplacement(_FS_DEC_TAG, True, fs_dec + self.assembled.text, False)
         sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, _FS_DEPTH, False)
         sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
         self._textures = {}

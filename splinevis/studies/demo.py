@@ -15,8 +15,8 @@ import numpy as np
 
 __all__ = ["render_showcase", "composite_scene", "EFFECT_PANELS"]
 
-CAMERA = [(2.4, -3.0, 2.2), (0.05, 0.0, 0.05), (0.0, 0.0, 1.0)]
-SPHERE = dict(center=(0.1, -0.1, 0.12), radius=0.32)
+CAMERA = [(2.5, -3.3, 2.4), (0.05, -0.1, 0.05), (0.0, 0.0, 1.0)]
+SPHERE = dict(center=(0.05, -0.15, 0.22), radius=0.3)
 
 
 def _checker(n=256, k=8):
@@ -68,8 +68,6 @@ def composite_scene(window_size=(640, 480), style=None, sphere=True):
         pl.add_mesh(pv.Sphere(theta_resolution=96, phi_resolution=96, **SPHERE), color="steelblue",
                     smooth_shading=True)
     pl.camera_position = CAMERA
-    pl.reset_camera()  # keep the view direction, fit the scene
-    pl.camera.zoom(1.25)
     pl.reset_camera_clipping_range()
     return pl, patch, actor
 
