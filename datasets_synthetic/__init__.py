@@ -1,0 +1,1 @@
+"""Generators of the synthetic test data (no downloads): analytic functions sampled on grids."""
