@@ -91,7 +91,7 @@ class Plotter(pv.Plotter):
         self._gl_checked = False
 
     def add_spline(self, model, style: Style | None = None, *, name: str | None = None, newton_iterations: int = 6,
-                   **style_options) -> SplineActor:
+                   program_options: dict | None = None, **style_options) -> SplineActor:
         """Add a spline model, ray-cast per pixel, beside any ordinary meshes.
 
         Parameters
@@ -105,6 +105,9 @@ class Plotter(pv.Plotter):
             Actor name (as in :meth:`pyvista.Plotter.add_actor`).
         newton_iterations : int, default 6
             Fixed Newton step count of the root finder, 1..8.
+        program_options : dict, optional
+            Options of the model's program builder (e.g. ``{"coefficients_in": "texture"}`` for the
+            analytic patch).
 
         Returns
         -------
@@ -113,7 +116,7 @@ class Plotter(pv.Plotter):
             render, the compiled sources (``.program_sources``).
         """
         st = _style_from(style, style_options)
-        spec = _builder_for(model)(model, newton_iterations=newton_iterations)
+        spec = _builder_for(model)(model, newton_iterations=newton_iterations, **(program_options or {}))
         spline = SplineActor(spec, st, self.renderer)
         self.add_actor(spline.actor, name=name, reset_camera=True)
         self._spline_actors.append(spline)

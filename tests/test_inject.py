@@ -139,3 +139,21 @@ def test_camera_inside_the_proxy_still_sees_the_surface():
     pl.close()
     red = (img[..., 0] > 200) & (img[..., 1] < 60)
     assert red.mean() > 0.3
+
+
+def test_float_texture_and_vertex_attribute_path_gives_the_same_image():
+    images = []
+    for where in ("uniform", "texture"):
+        pl = splinevis.Plotter(off_screen=True, window_size=(200, 150))
+        pl.set_background("white")
+        pl.add_spline(QuarticTrianglePatch.demo(), lights=1, program_options={"coefficients_in": where})
+        from splinevis.studies.demo import CAMERA
+
+        pl.camera_position = CAMERA
+        pl.reset_camera_clipping_range()
+        images.append(pl.screenshot().astype(int))
+        pl.close()
+    surface = ~np.all(images[0] == 255, axis=-1)
+    assert surface.mean() > 0.1
+    # Same float32 coefficients either way (RGBA32F texels are exact copies), so the same pixels.
+    assert np.array_equal(images[0], images[1])

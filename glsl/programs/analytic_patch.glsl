@@ -12,7 +12,25 @@
 #include "lib/blossom.glsl"
 #include "lib/roots.glsl"
 
+#ifdef SV_PATCH_TEXTURE
+// Coefficients from an RGBA32F table (VTK declares the sampler sv_patch_coeffs): row = patch id, texels
+// 0..3 hold the 15 coefficients (+1 padding). The patch id is a flat vertex attribute of the proxy.
+// This is the path terrains and volumes use for millions of patches; here it proves the plumbing.
+void sv_patch_load(out float b[15]) {
+    int row = int(sv_patch_idVSOut + 0.5);
+    for (int q = 0; q < 4; ++q) {
+        vec4 v = texelFetch(sv_patch_coeffs, ivec2(q, row), 0);
+        for (int r = 0; r < 4; ++r) {
+            if (4 * q + r < 15) b[4 * q + r] = v[r];
+        }
+    }
+}
+#else
 uniform float sv_patch_b[15];       // BB coefficients (heights), multi_indices(4, 2) order
+void sv_patch_load(out float b[15]) {
+    for (int q = 0; q < 15; ++q) b[q] = sv_patch_b[q];
+}
+#endif
 uniform vec3 sv_patch_bary0;        // rows of the matrix M with lam = M * (x, y, 1)
 uniform vec3 sv_patch_bary1;
 uniform vec3 sv_patch_bary2;
@@ -20,6 +38,8 @@ uniform vec2 sv_patch_zrange;       // (min, max) of the coefficients: the prism
 uniform int sv_newton_iterations;
 
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    float b[15];
+    sv_patch_load(b);
     hit.curvature = vec2(0.0);
     hit.depth = 0.0;
     // Barycentric coordinates along the ray are affine in t: lam(t) = lam_o + t * lam_d.
@@ -49,7 +69,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     vec3 l0 = lam_o + t0 * lam_d;
     vec3 l1 = lam_o + t1 * lam_d;
     float c[5];
-    sv_restrict_quartic_tri(sv_patch_b, l0, l1, c);
+    sv_restrict_quartic_tri(b, l0, l1, c);
     float z0 = ro.z + t0 * rd.z;
     float z1 = ro.z + t1 * rd.z;
     for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
@@ -62,7 +82,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     float f;
     vec3 a;
     float d[6];
-    sv_tri_quartic_jet(sv_patch_b, l, f, a, d);
+    sv_tri_quartic_jet(b, l, f, a, d);
     vec3 ux = m[0];  // d lam / dx (first column of M)
     vec3 uy = m[1];  // d lam / dy
     float fx = 4.0 * dot(ux, a);

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from .._validation import check_degree
 from ..gl.spec import ProgramSpec
 from .patch import QuarticTrianglePatch
@@ -9,17 +11,29 @@ from .patch import QuarticTrianglePatch
 __all__ = ["patch_program"]
 
 
-def patch_program(patch: QuarticTrianglePatch, *, newton_iterations: int = 6) -> ProgramSpec:
+def patch_program(patch: QuarticTrianglePatch, *, newton_iterations: int = 6,
+                  coefficients_in: str = "uniform") -> ProgramSpec:
     """Describe the ray-cast program of ``patch`` (proxy prism, coefficients and matrix as uniforms).
 
     ``newton_iterations`` (1..8) is the fixed Newton step count of lib/roots.glsl (paper 000: 5 hide
-    visible artifacts, 6 reach full float precision).
+    visible artifacts, 6 reach full float precision). ``coefficients_in="texture"`` reads the
+    coefficients from an RGBA32F table indexed by a per-vertex patch id instead of uniforms: the same
+    image, through the plumbing large models need.
     """
+    from .._validation import check_choice
+
+    check_choice(coefficients_in, "coefficients_in", {"uniform", "texture"})
     if not isinstance(patch, QuarticTrianglePatch):
         raise TypeError(f"patch must be a QuarticTrianglePatch, got {type(patch).__name__}.")
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
     points, triangles = patch.proxy()
     m = patch.barycentric_matrix
+    extra = {}
+    if coefficients_in == "texture":
+        table = np.zeros((1, 4, 4), dtype=np.float32)
+        table.reshape(-1)[:15] = patch.coefficients
+        extra = dict(defines={"SV_PATCH_TEXTURE": True}, textures={"sv_patch_coeffs": table},
+                     attributes={"sv_patch_id": np.zeros(len(points), dtype=np.float32)})
     return ProgramSpec(
         name="analytic_patch",
         entry="programs/analytic_patch.glsl",
@@ -34,4 +48,5 @@ def patch_program(patch: QuarticTrianglePatch, *, newton_iterations: int = 6) ->
             "sv_newton_iterations": iterations,
             "sv_scalar_range": patch.zrange,
         },
+        **extra,
     )
