@@ -31,12 +31,18 @@ def register_program(model_type, builder) -> None:
     _PROGRAMS[model_type] = builder
 
 
-def _builder_for(model):
-    if not _PROGRAMS:
-        from .analytic import QuarticTrianglePatch
-        from .analytic.program import patch_program
+def _register_builtin_programs():
+    from .analytic import QuarticTrianglePatch
+    from .analytic.program import patch_program
+    from .terrain.model import TerrainSpline
+    from .terrain.program import terrain_program
 
-        register_program(QuarticTrianglePatch, patch_program)
+    _PROGRAMS.setdefault(QuarticTrianglePatch, patch_program)
+    _PROGRAMS.setdefault(TerrainSpline, terrain_program)
+
+
+def _builder_for(model):
+    _register_builtin_programs()
     for cls in type(model).__mro__:
         if cls in _PROGRAMS:
             return _PROGRAMS[cls]
@@ -90,7 +96,7 @@ class Plotter(pv.Plotter):
         self._spline_actors: list[SplineActor] = []
         self._gl_checked = False
 
-    def add_spline(self, model, style: Style | None = None, *, name: str | None = None, newton_iterations: int = 6,
+    def add_spline(self, model, style: Style | None = None, *, name: str | None = None, newton_iterations: int = 8,
                    program_options: dict | None = None, **style_options) -> SplineActor:
         """Add a spline model, ray-cast per pixel, beside any ordinary meshes.
 
@@ -103,8 +109,8 @@ class Plotter(pv.Plotter):
             build or amend it. Only the declared effects are compiled in.
         name : str, optional
             Actor name (as in :meth:`pyvista.Plotter.add_actor`).
-        newton_iterations : int, default 6
-            Fixed Newton step count of the root finder, 1..8.
+        newton_iterations : int, default 8
+            Fixed iteration count of the root finder, 1..8 (safeguarded Newton steps per piece).
         program_options : dict, optional
             Options of the model's program builder (e.g. ``{"coefficients_in": "texture"}`` for the
             analytic patch).

@@ -33,7 +33,7 @@ def test_vertical_ray_hits_graph_at_function_value():
     assert np.allclose(5.0 - h.t, p.evaluate(xy), atol=1e-12)
 
 
-def test_ray_outside_triangle_misses_and_newton_twin_agrees_on_easy_rays():
+def test_ray_outside_triangle_misses_and_gpu_twin_agrees_with_reference():
     p = QuarticTrianglePatch.demo()
     h = p.raycast([5.0, 5.0, 5.0], [0.0, 0.0, -1.0])
     assert not h.hit
@@ -42,10 +42,12 @@ def test_ray_outside_triangle_misses_and_newton_twin_agrees_on_easy_rays():
     o = np.c_[xy, np.full(500, 3.0)]
     d = np.c_[rng.uniform(-0.2, 0.2, (500, 2)), -np.ones(500)]
     a = p.raycast(o, d, method="reference")
-    b = p.raycast(o, d, method="newton", iterations=8)
-    both = a.hit & b.hit
-    assert both.mean() > 0.9
-    assert np.allclose(a.t[both], b.t[both], atol=1e-10)
+    b = p.raycast(o, d, method="gpu", iterations=8)
+    assert a.hit.mean() > 0.5  # most rays of this bundle cross the patch (some leave the triangle)
+    assert np.array_equal(a.hit, b.hit)
+    # 8 safeguarded Newton steps from the Fourier end point converge quadratically on these simple
+    # roots; in float64 the remaining error is a few ulps of t (|t| < 4).
+    assert np.allclose(a.t[a.hit], b.t[b.hit], atol=1e-12)
 
 
 def test_flat_patch_has_a_proxy_with_volume():
@@ -80,7 +82,7 @@ def test_bad_raycast_method_and_iterations():
     with pytest.raises(ValueError, match="method 'bisect' is not known"):
         p.raycast([0, 0, 1], [0, 0, -1], method="bisect")
     with pytest.raises(ValueError, match="iterations"):
-        p.raycast([0, 0, 1], [0, 0, -1], method="newton", iterations=0)
+        p.raycast([0, 0, 1], [0, 0, -1], method="gpu", iterations=0)
 
 
 def test_patch_coefficient_order_matches_multi_indices():

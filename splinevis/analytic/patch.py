@@ -178,15 +178,17 @@ class QuarticTrianglePatch:
             Rays ``o + t d``; directions need not be unit.
         tmin : float or (…) array_like
             Smallest admissible t (0 for perspective rays starting at the eye, -inf for parallel rays).
-        method : {"reference", "newton"}
-            ``"newton"`` mirrors the shader (secure-start Newton, ``iterations`` steps);
-            ``"reference"`` takes the first root from the robust all-roots finder.
+        method : {"reference", "gpu", "paper"}
+            ``"gpu"`` mirrors the shader's default root finder (bracketed Newton on the convex pieces
+            between the secure starting points, ``iterations`` steps); ``"paper"`` is paper 000's
+            four-start Newton (``SV_ROOTS_PAPER_NEWTON``); ``"reference"`` takes the first root from
+            the robust all-roots finder.
 
         Returns
         -------
         RayHits
         """
-        check_choice(method, "method", {"reference", "newton"})
+        check_choice(method, "method", {"reference", "gpu", "paper"})
         o = as_float64_array(origins, "origins", shape_tail=(3,))
         d = as_float64_array(directions, "directions", shape_tail=(3,))
         o, d = np.broadcast_arrays(o, d)
@@ -221,7 +223,9 @@ class QuarticTrianglePatch:
         z1 = o[..., 2] + t1 * d[..., 2]
         k = np.arange(DEGREE + 1) / DEGREE
         c = c - (z0[..., None] * (1 - k) + z1[..., None] * k)
-        if method == "newton":
+        if method == "gpu":
+            s = _roots.first_root_bracketed(c, iterations=iterations)
+        elif method == "paper":
             s = _roots.newton_secure(c, iterations=iterations)
         else:
             s = _roots.first_root_reference(c)

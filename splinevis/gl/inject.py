@@ -248,6 +248,8 @@ class SplineActor:
 
         actor = vtkActor()
         actor.SetMapper(mapper)
+        self.offset = np.asarray(spec.offset, dtype=np.float64).reshape(3)
+        actor.SetPosition(*self.offset.tolist())
         prop = actor.GetProperty()
         if cull_front:
             prop.FrontfaceCullingOn()
@@ -292,8 +294,8 @@ class SplineActor:
     def camera_frame(self):
         """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera."""
         cam = self.renderer.GetActiveCamera()
-        eye = np.array(cam.GetPosition(), dtype=np.float64)
-        focal = np.array(cam.GetFocalPoint(), dtype=np.float64)
+        eye = np.array(cam.GetPosition(), dtype=np.float64) - self.offset  # model frame (double precision)
+        focal = np.array(cam.GetFocalPoint(), dtype=np.float64) - self.offset
         view = focal - eye
         view /= np.linalg.norm(view)
         m = cam.GetViewTransformMatrix()

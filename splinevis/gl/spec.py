@@ -35,6 +35,10 @@ class ProgramSpec:
         forwarded to the fragment shader as ``<name>VSOut`` (flat).
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    offset : (3,) float64, optional
+        World position of the model frame's origin. Model coordinates (``points``, everything the
+        shader sees) are world minus ``offset``; VTK composes the translation in double precision, so
+        UTM-sized coordinates never reach float32.
     """
 
     name: str
@@ -46,3 +50,4 @@ class ProgramSpec:
     textures: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
     frame_uniforms: Callable | None = None
+    offset: tuple = (0.0, 0.0, 0.0)

@@ -1,0 +1,192 @@
+// Ray casting a quartic terrain spline (paper 000) through a min/max hierarchy, per fragment.
+//
+// Proxy: one box around the whole terrain, rasterized with front faces culled. Each fragment's ray is
+// taken to index space (u, v in spline cells, z = height relative to the reference height) and walks a
+// quadtree of (min, max) coefficient bounds, front to back (the hierarchical equivalent of the paper's
+// occlusion sets): a block whose bounds the ray's height range over the block misses is skipped whole;
+// otherwise the walk descends; a cell (level 0) is tested triangle by triangle exactly as one patch of
+// programs/analytic_patch.glsl (clip, restrict by blossoming, first root, paper 000 sec. VI). The frame
+// cost grows with the number of blocks a ray visits (~ log of the grid size for most rays), not with
+// the patch count. The float64 reference is splinevis.terrain.raycast (a plain cell-by-cell DDA).
+#include "lib/raycast.glsl"
+#include "lib/bb_triangle.glsl"
+#include "lib/blossom.glsl"
+#include "lib/roots.glsl"
+
+// VTK declares the samplers of the textures set on the actor: sv_terrain_coef (RGBA32F, 8 texels per
+// cell: T0's 15 then T1's 15 coefficients, row = cell j, texel 8 i + q) and sv_terrain_minmax
+// (RGBA32F atlas of the hierarchy: level L's block (bi, bj) at texel (sv_level_offset[L] + bi, bj), .rg =
+// (min, max)).
+uniform float sv_level_offset[16];
+uniform int sv_top_level;
+uniform vec2 sv_ncells;            // (ncx, ncy)
+uniform vec2 sv_index_scale;       // u = sv_index_scale.x * x_mc + sv_index_shift.x (likewise v)
+uniform vec2 sv_index_shift;
+uniform vec2 sv_zrange;            // coefficient range, model z
+uniform int sv_max_steps;          // hierarchy steps per ray before giving up
+uniform int sv_newton_iterations;
+uniform float sv_scalar_offset;    // reference height: hit.scalar is the physical height (colormaps)
+
+vec2 sv_block_minmax(int level, ivec2 b) {
+    return texelFetch(sv_terrain_minmax, ivec2(int(sv_level_offset[level]) + b.x, b.y), 0).rg;
+}
+
+void sv_load_cell(ivec2 c, out float b0[15], out float b1[15]) {
+    float w[32];
+    for (int q = 0; q < 8; ++q) {
+        vec4 v = texelFetch(sv_terrain_coef, ivec2(8 * c.x + q, c.y), 0);
+        w[4 * q] = v.x; w[4 * q + 1] = v.y; w[4 * q + 2] = v.z; w[4 * q + 3] = v.w;
+    }
+    for (int q = 0; q < 15; ++q) {
+        b0[q] = w[q];
+        b1[q] = w[15 + q];
+    }
+}
+
+// Barycentric coordinates of cell-local (u, v): T0 = [(0,0),(1,0),(1,1)], T1 = [(0,0),(1,1),(0,1)].
+vec3 sv_cell_bary(vec2 p, int tri) {
+    return tri == 0 ? vec3(1.0 - p.x, p.x - p.y, p.y) : vec3(1.0 - p.y, p.x, p.y - p.x);
+}
+
+// First hit of the cell-local ray (o + t d) with triangle `tri` for t in [ta, tb]; -1 if none.
+float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
+    vec3 lo = sv_cell_bary(o.xy, tri);
+    vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
+    float t0 = ta;
+    float t1 = tb;
+    for (int k = 0; k < 3; ++k) {
+        if (abs(ld[k]) < 1e-30) {
+            if (lo[k] < 0.0) return -1.0;
+        } else {
+            float tc = -lo[k] / ld[k];
+            if (ld[k] > 0.0) t0 = max(t0, tc); else t1 = min(t1, tc);
+        }
+    }
+    float zlo = b[0];
+    float zhi = b[0];
+    for (int q = 1; q < 15; ++q) { zlo = min(zlo, b[q]); zhi = max(zhi, b[q]); }
+    if (abs(d.z) < 1e-30) {
+        if (o.z < zlo || o.z > zhi) return -1.0;
+    } else {
+        float za = (zlo - o.z) / d.z;
+        float zb = (zhi - o.z) / d.z;
+        t0 = max(t0, min(za, zb));
+        t1 = min(t1, max(za, zb));
+    }
+    if (!(t0 <= t1)) return -1.0;
+    float c[5];
+    sv_restrict_quartic_tri(b, lo + t0 * ld, lo + t1 * ld, c);
+    float z0 = o.z + t0 * d.z;
+    float z1 = o.z + t1 * d.z;
+    for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
+    float s = sv_first_root(c, 4, sv_newton_iterations);
+    return s < 0.0 ? -1.0 : mix(t0, t1, s);
+}
+
+bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    hit.curvature = vec2(0.0);
+    hit.depth = 0.0;
+    // The ray in index space: P(t) = P0 + t D (t unchanged).
+    vec3 P0 = vec3(sv_index_scale * ro.xy + sv_index_shift, ro.z);
+    vec3 D = vec3(sv_index_scale * rd.xy, rd.z);
+    // Clip to the terrain's box.
+    float t = tmin;
+    float t_end = 3.0e38;
+    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
+    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
+    for (int k = 0; k < 3; ++k) {
+        if (abs(D[k]) < 1e-30) {
+            if (P0[k] < blo[k] || P0[k] > bhi[k]) return false;
+        } else {
+            float ta = (blo[k] - P0[k]) / D[k];
+            float tb = (bhi[k] - P0[k]) / D[k];
+            t = max(t, min(ta, tb));
+            t_end = min(t_end, max(ta, tb));
+        }
+    }
+    if (!(t <= t_end)) return false;
+
+    int L = sv_top_level;
+    ivec2 c = ivec2(0);
+    ivec2 stepdir = ivec2(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1);
+    float t_hit = -1.0;
+    ivec2 cell_hit = ivec2(0);
+    for (int s = 0; s < sv_max_steps; ++s) {
+        float size = float(1 << L);
+        vec2 lo = vec2(c) * size;
+        vec2 hi = min(lo + vec2(size), sv_ncells);
+        float tx = abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? hi.x : lo.x) - P0.x) / D.x;
+        float ty = abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? hi.y : lo.y) - P0.y) / D.y;
+        float tb = min(min(tx, ty), t_end);
+        vec2 mm = sv_block_minmax(L, c);
+        float za = P0.z + t * D.z;
+        float zb = P0.z + tb * D.z;
+        if (max(za, zb) >= mm.x && min(za, zb) <= mm.y) {
+            if (L > 0) {
+                // Descend to the child holding P(t); clamp to c's children (P(t) may sit on a border).
+                L -= 1;
+                vec2 p = P0.xy + t * D.xy;
+                ivec2 child = ivec2(floor(p / float(1 << L)));
+                c = clamp(child, 2 * c, 2 * c + ivec2(1));
+                continue;
+            }
+            float b0[15];
+            float b1[15];
+            sv_load_cell(c, b0, b1);
+            vec3 o = vec3(P0.xy - vec2(c), P0.z);
+            float h0 = sv_triangle_hit(b0, 0, o, D, t, tb);
+            float h1 = sv_triangle_hit(b1, 1, o, D, t, tb);
+            float th = h0 < 0.0 ? h1 : (h1 < 0.0 ? h0 : min(h0, h1));
+            if (th >= 0.0) {
+                t_hit = th;
+                cell_hit = c;
+                break;
+            }
+        }
+        if (tb >= t_end) break;
+        // Step to the neighbouring block across the face the ray leaves through.
+        ivec2 parent = c / 2;
+        if (tx <= ty) c.x += stepdir.x; else c.y += stepdir.y;
+        t = tb;
+        ivec2 nb = ivec2(ceil(sv_ncells / size));
+        if (c.x < 0 || c.y < 0 || c.x >= nb.x || c.y >= nb.y) break;
+        // Entering another parent block: go up, so empty regions are skipped at the coarsest level.
+        if (L < sv_top_level && (c / 2) != parent) {
+            L += 1;
+            c = c / 2;
+        }
+    }
+    if (t_hit < 0.0) return false;
+
+    hit.t = t_hit;
+    hit.pos = ro + t_hit * rd;
+    vec3 P = P0 + t_hit * D;
+    vec2 local = P.xy - vec2(cell_hit);
+    int tri = local.y > local.x ? 1 : 0;
+    float b0[15];
+    float b1[15];
+    sv_load_cell(cell_hit, b0, b1);
+    float b[15];
+    for (int q = 0; q < 15; ++q) b[q] = tri == 0 ? b0[q] : b1[q];
+    vec3 l = sv_cell_bary(local, tri);
+    float f;
+    vec3 a;
+    float dd[6];
+    sv_tri_quartic_jet(b, l, f, a, dd);
+    vec3 du = sv_cell_bary(vec2(1.0, 0.0), tri) - sv_cell_bary(vec2(0.0), tri);
+    vec3 dv = sv_cell_bary(vec2(0.0, 1.0), tri) - sv_cell_bary(vec2(0.0), tri);
+    float fx = 4.0 * dot(du, a) * sv_index_scale.x;
+    float fy = 4.0 * dot(dv, a) * sv_index_scale.y;
+    hit.normal = vec3(-fx, -fy, 1.0);
+    hit.scalar = f + sv_scalar_offset;
+    hit.uv = P.xy / sv_ncells;
+#ifdef SV_OUT_CURVATURE
+    float fxx = sv_tri_quartic_d2(dd, du, du) * sv_index_scale.x * sv_index_scale.x;
+    float fxy = sv_tri_quartic_d2(dd, du, dv) * sv_index_scale.x * sv_index_scale.y;
+    float fyy = sv_tri_quartic_d2(dd, dv, dv) * sv_index_scale.y * sv_index_scale.y;
+    float g = 1.0 + fx * fx + fy * fy;
+    hit.curvature = vec2(((1.0 + fy * fy) * fxx - 2.0 * fx * fy * fxy + (1.0 + fx * fx) * fyy) / (2.0 * pow(g, 1.5)),
+                         (fxx * fyy - fxy * fxy) / (g * g));
+#endif
+    return true;
+}

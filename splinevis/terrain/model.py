@@ -1,0 +1,187 @@
+"""TerrainSpline: a quartic spline on the type-1 triangulation of a height grid (paper 000).
+
+The model is immutable float64 numpy and never imports VTK. Geometry is kept exactly as the data gave
+it: anisotropic spacing and real-world origins (UTM eastings of 5e5, northings of 5e6) are stored in
+float64, and everything the GPU sees is expressed in a *local frame* -- model coordinates relative to
+``offset`` = (centre x, centre y, reference height) -- so float32 keeps sub-millimetre precision on
+UTM-sized data (see ``splinevis.gl.inject``: the actor is placed at ``offset`` in double precision).
+
+Index space: spline cell (i, j) is [i, i+1] x [j, j+1] with triangles
+T0 = [(0,0), (1,0), (1,1)] and T1 = [(0,0), (1,1), (0,1)] (cell-local coordinates); physical
+x = x0 + u * cell_dx, y = y0 + v * cell_dy, z = z_ref + (spline value).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validation import as_float64_array, check_choice
+from ..bb import simplex as _simplex
+
+__all__ = ["TerrainSpline", "cell_barycentric"]
+
+
+def cell_barycentric(u, v, tri):
+    """Barycentric coordinates (…, 3) of cell-local (u, v) in triangle ``tri`` (0 or 1, arrays allowed).
+
+    T0 = [(0,0), (1,0), (1,1)]: (1 - u, u - v, v);  T1 = [(0,0), (1,1), (0,1)]: (1 - v, u, v - u).
+    """
+    u = np.asarray(u, dtype=np.float64)
+    v = np.asarray(v, dtype=np.float64)
+    tri = np.asarray(tri)
+    l0 = np.where(tri == 0, 1.0 - u, 1.0 - v)
+    l1 = np.where(tri == 0, u - v, u)
+    l2 = np.where(tri == 0, v, v - u)
+    return np.stack([l0, l1, l2], axis=-1)
+
+
+#: d(lambda)/du and d(lambda)/dv of T0 and T1 (rows: triangle; columns: lambda components)
+_DLAM_DU = np.array([[-1.0, 1.0, 0.0], [0.0, 1.0, -1.0]])
+_DLAM_DV = np.array([[0.0, -1.0, 1.0], [-1.0, 0.0, 1.0]])
+
+
+class TerrainSpline:
+    """A quartic spline surface z = s(x, y) over a height grid.
+
+    Build one with :meth:`from_heights` (a scheme of :mod:`splinevis.terrain.schemes` applied to a
+    :class:`~splinevis.io.HeightGrid` or a 2-D array) or :meth:`from_coefficients`.
+
+    Attributes
+    ----------
+    coefficients : (ncy, ncx, 2, 15) ndarray
+        BB coefficients of T0 and T1 of every cell, heights relative to ``z_ref``.
+    cell_spacing : (float, float)
+        Physical size of a spline cell (data spacing times the scheme's cell size: 4 for C0).
+    origin : (float, float)
+        Physical position of index point (0, 0).
+    z_ref : float
+        Reference height (the data mean): coefficients are stored relative to it.
+    scheme : str
+    """
+
+    def __init__(self, coefficients, cell_spacing, origin=(0.0, 0.0), z_ref=0.0, scheme="custom", source=""):
+        c = as_float64_array(coefficients, "coefficients", ndim=4)
+        if c.shape[2:] != (2, 15) or c.shape[0] < 1 or c.shape[1] < 1:
+            raise ValueError(f"coefficients must have shape (ncy, ncx, 2, 15), got {c.shape}.")
+        sp = as_float64_array(cell_spacing, "cell_spacing", ndim=1, shape_tail=(2,))
+        if not (sp > 0).all():
+            raise ValueError(f"cell_spacing must be positive, got {tuple(sp)}.")
+        org = as_float64_array(origin, "origin", ndim=1, shape_tail=(2,))
+        z_ref = float(as_float64_array(z_ref, "z_ref", ndim=0))
+        self._c = np.ascontiguousarray(c)
+        self._c.setflags(write=False)
+        self.cell_spacing = (float(sp[0]), float(sp[1]))
+        self.origin = (float(org[0]), float(org[1]))
+        self.z_ref = z_ref
+        self.scheme = scheme
+        self.source = source
+        self._pyramid = None
+
+    @classmethod
+    def from_coefficients(cls, coefficients, cell_spacing=(1.0, 1.0), origin=(0.0, 0.0), z_ref=0.0):
+        return cls(coefficients, cell_spacing, origin, z_ref, scheme="custom", source="coefficients")
+
+    @classmethod
+    def from_heights(cls, heights, scheme: str = "C1", **read_options) -> "TerrainSpline":
+        """Apply ``scheme`` to height data (anything :func:`splinevis.io.read_heights` reads)."""
+        from ..io import HeightGrid, read_heights
+        from .schemes import SCHEMES, terrain_coefficients
+
+        check_choice(scheme, "scheme", set(SCHEMES))
+        grid = heights if isinstance(heights, HeightGrid) else read_heights(heights, **read_options)
+        z = np.asarray(grid.heights, dtype=np.float64)
+        z_ref = float(np.mean(z))
+        coef, info = terrain_coefficients(z - z_ref, scheme)
+        cell = info["cell_size"] if isinstance(info, dict) else info.cell_size
+        sp = (grid.spacing[0] * cell, grid.spacing[1] * cell)
+        return cls(coef, sp, grid.origin, z_ref, scheme=scheme, source=grid.source)
+
+    # -- data -----------------------------------------------------------------------------------------
+    @property
+    def coefficients(self) -> np.ndarray:
+        return self._c
+
+    @property
+    def shape(self) -> tuple:
+        """(ncy, ncx): number of spline cells."""
+        return self._c.shape[:2]
+
+    @property
+    def num_patches(self) -> int:
+        return 2 * self._c.shape[0] * self._c.shape[1]
+
+    @property
+    def extent(self) -> tuple:
+        """(xmin, xmax, ymin, ymax) of the domain."""
+        ncy, ncx = self.shape
+        return (self.origin[0], self.origin[0] + ncx * self.cell_spacing[0],
+                self.origin[1], self.origin[1] + ncy * self.cell_spacing[1])
+
+    @property
+    def zrange(self) -> tuple:
+        """(min, max) physical height bound from the coefficients (convex hull property)."""
+        return (self.z_ref + float(self._c.min()), self.z_ref + float(self._c.max()))
+
+    @property
+    def offset(self) -> np.ndarray:
+        """Origin of the local (model) frame: domain centre and z_ref, float64."""
+        x0, x1, y0, y1 = self.extent
+        return np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1), self.z_ref])
+
+    def minmax_pyramid(self) -> list:
+        """Per level L a (ceil(ncy/2^L), ceil(ncx/2^L), 2) array of (min, max) coefficient bounds of the
+        blocks of 2^L x 2^L cells; level 0 = cells. The last level is a single block."""
+        if self._pyramid is None:
+            c = self._c.reshape(self._c.shape[0], self._c.shape[1], 30)
+            lvl = np.stack([c.min(axis=-1), c.max(axis=-1)], axis=-1)
+            levels = [lvl]
+            while lvl.shape[0] > 1 or lvl.shape[1] > 1:
+                ny, nx = lvl.shape[:2]
+                py, px = ny % 2, nx % 2
+                lo = np.pad(lvl[..., 0], ((0, py), (0, px)), constant_values=np.inf)
+                hi = np.pad(lvl[..., 1], ((0, py), (0, px)), constant_values=-np.inf)
+                lo = lo.reshape(lo.shape[0] // 2, 2, lo.shape[1] // 2, 2).min(axis=(1, 3))
+                hi = hi.reshape(hi.shape[0] // 2, 2, hi.shape[1] // 2, 2).max(axis=(1, 3))
+                lvl = np.stack([lo, hi], axis=-1)
+                levels.append(lvl)
+            self._pyramid = levels
+        return self._pyramid
+
+    # -- evaluation -----------------------------------------------------------------------------------
+    def to_index(self, x, y):
+        """Physical (x, y) -> index coordinates (u, v) in spline cells."""
+        u = (np.asarray(x, dtype=np.float64) - self.origin[0]) / self.cell_spacing[0]
+        v = (np.asarray(y, dtype=np.float64) - self.origin[1]) / self.cell_spacing[1]
+        return u, v
+
+    def _locate(self, u, v):
+        ncy, ncx = self.shape
+        i = np.clip(np.floor(u).astype(np.int64), 0, ncx - 1)
+        j = np.clip(np.floor(v).astype(np.int64), 0, ncy - 1)
+        lu, lv = u - i, v - j
+        tri = (lv > lu).astype(np.int64)
+        return i, j, tri, lu, lv
+
+    def evaluate(self, x, y) -> np.ndarray:
+        """Physical height s(x, y) (points outside the domain are extrapolated from the border cell)."""
+        u, v = self.to_index(x, y)
+        i, j, tri, lu, lv = self._locate(u, v)
+        lam = cell_barycentric(lu, lv, tri)
+        return self.z_ref + _simplex.de_casteljau(self._c[j, i, tri], lam, d=2)
+
+    def gradient(self, x, y) -> np.ndarray:
+        """(…, 2) physical gradient (ds/dx, ds/dy)."""
+        u, v = self.to_index(x, y)
+        i, j, tri, lu, lv = self._locate(u, v)
+        lam = cell_barycentric(lu, lv, tri)
+        c = self._c[j, i, tri]
+        out = []
+        for table, h in ((_DLAM_DU, self.cell_spacing[0]), (_DLAM_DV, self.cell_spacing[1])):
+            dc = _simplex.derivative(c, table[tri], d=2)
+            out.append(_simplex.de_casteljau(dc, lam, d=2) / h)
+        return np.stack(out, axis=-1)
+
+    def __repr__(self):
+        ncy, ncx = self.shape
+        return (f"TerrainSpline(scheme={self.scheme!r}, cells={ncx}x{ncy}, patches={self.num_patches}, "
+                f"cell_spacing={self.cell_spacing}, origin={self.origin}, z_ref={self.z_ref:g})")
