@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bounds import ray_depth_error_bound
 from .rays import pixel_rays, window_depth
 
 __all__ = ["front_surface_agreement", "patch_depth_agreement"]
@@ -81,38 +82,12 @@ def front_surface_agreement(window_size=(640, 480)) -> dict:
     }
 
 
-#: float32 unit roundoff
-U32 = 2.0 ** -24
-
-
 def depth_error_bound(patch, matrix, origins, directions, t) -> np.ndarray:
-    """Per-pixel bound on |GPU depth - float64 depth| for hits at ray parameters ``t``.
-
-    Derivation (float32 arithmetic, unit roundoff u = 2^-24):
-
-    * The shader evaluates g(t) = f(ray_xy(t)) - ray_z(t) through four triangle de Casteljau levels for
-      the blossoms (each level <= 4 roundings on a convex combination: 16 u max|b|), one univariate
-      de Casteljau of degree 4 for Newton (12 u sum|c_k| B_k <= 12 u (max|b| + max|z|)) and the ray's
-      height z0 + t dz (4 u (|o_z| + |t d_z|)). So |g_32 - g| <= eps_g = 32 u (max|b| + |z|).
-    * Newton stops at a zero of g_32, so the root moves by at most eps_g / |g'(t)| with
-      g'(t) = grad f . d_xy - d_z (first-order perturbation of a simple root).
-    * Window depth d(t) then moves by |d'(t)| eps_g / |g'(t)|; computing d from the clip coordinates
-      costs another 8 u (a 4-term dot product and a division, near d ~ 1), and the depth buffer
-      quantizes to 2^-24.
-
-    Near tangential rays g' -> 0 and the bound grows, as the problem's condition does.
-    """
-    o = np.asarray(origins, dtype=np.float64)
-    d = np.asarray(directions, dtype=np.float64)
-    p = o + t[..., None] * d
-    grad = patch.gradient(p[..., :2])
-    gprime = np.abs(np.einsum("...i,...i->...", grad, d[..., :2]) - d[..., 2])
-    zmag = np.maximum(np.abs(patch.coefficients).max(), np.abs(p[..., 2]))
-    eps_g = 32.0 * U32 * (np.abs(patch.coefficients).max() + zmag)
-    dt = eps_g / np.maximum(gprime, 1e-300)
-    h = 1e-6 * np.maximum(1.0, np.abs(t))
-    dd_dt = np.abs(window_depth(matrix, o + (t + h)[..., None] * d) - window_depth(matrix, o + (t - h)[..., None] * d)) / (2 * h)
-    return dd_dt * dt + 8.0 * U32 + 2.0 ** -24
+    """Per-pixel bound on |GPU depth - float64 depth| for the analytic patch (see
+    :func:`splinevis.analysis.bounds.ray_depth_error_bound`)."""
+    p = np.asarray(origins) + t[..., None] * np.asarray(directions)
+    return ray_depth_error_bound(lambda q: patch.gradient(q), float(np.abs(patch.coefficients).max()), matrix,
+                                 origins, directions, t, np.abs(p[..., :2]))
 
 
 def patch_depth_agreement(window_size=(640, 480), camera=None, newton_iterations=6) -> dict:

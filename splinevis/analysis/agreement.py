@@ -1,0 +1,95 @@
+"""GPU against float64, per pixel: hits, misses and window depths of any spline model.
+
+The model is rendered alone (unlit, no effects: depth does not depend on shading), the depth buffer is
+read back, and every pixel's ray is cast in float64 by the model's reference ray caster with the same
+camera matrix. Depth differences are judged against a derived per-pixel bound
+(:func:`splinevis.analysis.bounds.ray_depth_error_bound`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from .bounds import ray_depth_error_bound
+from .rays import pixel_rays, window_depth
+
+__all__ = ["depth_agreement", "reference_hits"]
+
+
+def reference_hits(model, origins, directions, *, method="reference"):
+    """Float64 ray cast of a supported model (analytic patch or terrain)."""
+    from ..analytic import QuarticTrianglePatch
+    from ..terrain.model import TerrainSpline
+    from ..terrain.raycast import raycast_terrain
+
+    if isinstance(model, QuarticTrianglePatch):
+        return model.raycast(origins, directions, 0.0, method=method)
+    if isinstance(model, TerrainSpline):
+        return raycast_terrain(model, origins, directions, 0.0, method=method)
+    raise TypeError(f"no float64 ray caster for {type(model).__name__}")
+
+
+def _bound(model, matrix, o, d, t):
+    from ..analytic import QuarticTrianglePatch
+
+    p = o + t[..., None] * d
+    if isinstance(model, QuarticTrianglePatch):
+        return ray_depth_error_bound(lambda q: model.gradient(q), float(np.abs(model.coefficients).max()), matrix,
+                                     o, d, t, np.abs(p[..., :2]))
+    # terrain: the shader works in the model frame (world - offset) and in index coordinates
+    off = model.offset
+    o_mc = o - off
+    coord = np.abs(p[..., :2] - np.asarray(model.origin))
+    return ray_depth_error_bound(lambda q: model.gradient(q[..., 0] + off[0], q[..., 1] + off[1]),
+                                 float(np.abs(model.coefficients).max()), _shift(matrix, off),
+                                 o_mc, d, t, coord)
+
+
+def _shift(matrix, off):
+    """Camera matrix acting on model-frame points (world = model + off)."""
+    T = np.eye(4)
+    T[:3, 3] = off
+    return np.asarray(matrix) @ T
+
+
+def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_iterations=8, plotter_hook=None) -> dict:
+    """Render ``model`` alone from ``camera_position`` and compare with the float64 reference.
+
+    Returns a dict: ``pixels``, ``hit_disagree`` (pixels where exactly one side hits), ``leaks``
+    (GPU misses at pixels whose reference hits and whose 8 neighbours all hit: cracks), ``both``,
+    ``depth_error`` and ``depth_bound`` (over pixels where both hit), ``gpu_depth``,
+    ``reference_depth``, ``matrix``.
+    """
+    from ..plotting import Plotter
+
+    w, h = window_size
+    pl = Plotter(off_screen=True, window_size=window_size)
+    pl.add_spline(model, lights=0, color=(1.0, 0.0, 0.0), newton_iterations=newton_iterations)
+    pl.camera_position = camera_position
+    pl.reset_camera_clipping_range()
+    if plotter_hook is not None:
+        plotter_hook(pl)
+    pl.screenshot()
+    gpu = pl.depth_buffer()
+    matrix = pl.camera_matrix()
+    pl.close()
+    o, d = pixel_rays(matrix, w, h)
+    hits = reference_hits(model, o, d)
+    ref = window_depth(matrix, o + hits.t[..., None] * d)
+    ref_hit = np.isfinite(ref) & (ref >= 0) & (ref <= 1)
+    gpu_hit = gpu < 1.0
+    both = gpu_hit & ref_hit
+    interior = ndimage.binary_erosion(ref_hit, structure=np.ones((3, 3)), border_value=0)
+    bound = _bound(model, matrix, o[both], d[both], hits.t[both])
+    return {
+        "pixels": w * h,
+        "hit_disagree": int((gpu_hit != ref_hit).sum()),
+        "leaks": int((interior & ~gpu_hit).sum()),
+        "both": int(both.sum()),
+        "depth_error": np.abs(gpu - ref)[both],
+        "depth_bound": bound,
+        "gpu_depth": gpu,
+        "reference_depth": ref,
+        "matrix": matrix,
+    }

@@ -1,0 +1,338 @@
+"""splinevis.io.read_heights: every reader round-trips exact reference values; bad input fails clearly."""
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from datasets_synthetic.dem_files import DEM_VOID, fractal_terrain, write_geotiff, write_usgs_ascii_dem
+from splinevis.io import HeightGrid, read_heights
+
+tifffile = pytest.importorskip("tifffile")
+
+UTM = (5e5, 5.1e6)
+
+
+def plane(nx, ny, dx=1.0, dy=1.0, x0=0.0, y0=0.0):
+    """Heights 3 + 2x - 0.5y (in local coordinates) on the grid; rows south to north."""
+    x = np.arange(nx) * dx
+    y = np.arange(ny) * dy
+    return 3.0 + 2.0 * x[None, :] - 0.5 * y[:, None]
+
+
+# ---- numpy -----------------------------------------------------------------------------------------
+def test_numpy_defaults_and_geometry():
+    h = np.arange(12.0).reshape(3, 4)
+    g = read_heights(h)
+    assert g.spacing == (1.0, 1.0) and g.origin == (0.0, 0.0) and g.source == "numpy array"
+    assert g.shape == (3, 4) and g.extent == (0.0, 3.0, 0.0, 2.0) and g.height_range == (0.0, 11.0)
+    assert np.array_equal(g.heights, h) and not g.heights.flags.writeable
+    h[0, 0] = 99  # the grid holds a copy
+    assert g.heights[0, 0] == 0
+
+
+def test_numpy_anisotropic_utm_kept_exactly_and_points():
+    h = np.arange(6, dtype=np.int16).reshape(2, 3)
+    g = read_heights(h, spacing=(0.5, 2.0), origin=UTM)
+    assert g.heights.dtype == np.float64
+    assert g.spacing == (0.5, 2.0) and g.origin == (500000.0, 5100000.0)
+    assert np.array_equal(g.x, [500000.0, 500000.5, 500001.0]) and np.array_equal(g.y, [5100000.0, 5100002.0])
+    p = g.points()
+    assert p.shape == (6, 3)
+    assert np.array_equal(p[4], [500000.5, 5100002.0, 4.0])  # x fastest: index 4 is (i=1, j=1)
+
+
+@pytest.mark.parametrize(
+    "value, kwargs, exc, match",
+    [
+        (np.zeros(5), {}, ValueError, r"2-D array \(ny, nx\), got shape \(5,\)"),
+        (np.zeros((2, 3, 4)), {}, ValueError, r"got shape \(2, 3, 4\)\. Squeeze"),
+        (np.zeros((0, 3)), {}, ValueError, r"at least 2 x 2 samples, got shape \(0, 3\)"),
+        (np.array([["a", "b"], ["c", "d"]]), {}, TypeError, r"real numbers, got dtype <U1 \(strings\)"),
+        (np.zeros((2, 2)), {"spacing": (1.0, 0.0)}, ValueError, r"spacing must be > 0 in x and y, got \(1.0, 0.0\)"),
+        (np.zeros((2, 2)), {"spacing": (1.0, -2.0)}, ValueError, r"spacing must be > 0"),
+        (np.zeros((2, 2)), {"spacing": "1,1"}, TypeError, r"spacing must be two real numbers, got the string"),
+        (np.zeros((2, 2)), {"origin": (np.nan, 0.0)}, ValueError, r"origin must be finite, got \(nan, 0.0\)"),
+        (np.zeros((2, 2)), {"origin": (1.0, 2.0, 3.0)}, ValueError, r"origin must be two numbers \(x, y\)"),
+        (np.zeros((2, 2)), {"fill": "cubic"}, ValueError, r"fill 'cubic' is not known; choose one of: 'linear', 'nearest'"),
+        (np.zeros((2, 2)), {"resample": "spline"}, ValueError, r"resample 'spline' is not known"),
+        (np.zeros((2, 2)), {"scalars": "z"}, ValueError, r"a numpy array has none"),
+        ({"h": 1}, {}, TypeError, r"source of type dict is not supported; pass a 2-D numpy array"),
+    ],
+)
+def test_bad_inputs(value, kwargs, exc, match):
+    with pytest.raises(exc, match=match):
+        read_heights(value, **kwargs)
+
+
+def test_heightgrid_validates_itself():
+    with pytest.raises(ValueError, match=r"heights must have finite values; found 1 non-finite"):
+        HeightGrid(np.array([[0.0, np.nan], [1.0, 2.0]]), (1, 1), (0, 0))
+
+
+# ---- missing samples ---------------------------------------------------------------------------------
+def test_nan_error_names_source_count_position_coordinate_and_fix():
+    h = plane(5, 4)
+    h[2, 3] = np.nan
+    h[3, 0] = -9999.0
+    with pytest.raises(ValueError, match=r"numpy array: 2 of 20 samples are missing .*\(row, col\) = \(2, 3\) "
+                                         r"\[array index \[row, col\]\], \(x, y\) = \(10.5, 104.0\).*"
+                                         r"Pass fill='nearest' or fill='linear'"):
+        read_heights(h, nodata=-9999, spacing=(2.5, 2.0), origin=(3.0, 100.0))
+
+
+def test_all_missing_is_an_error():
+    with pytest.raises(ValueError, match=r"all 4 samples are missing"):
+        read_heights(np.full((2, 2), -1.0), nodata=-1, fill="nearest")
+
+
+def test_linear_fill_reproduces_a_plane_and_nearest_uses_world_distance():
+    dx, dy = 1.0, 10.0
+    h = plane(6, 5, dx, dy)
+    holes = h.copy()
+    holes[2, 2:4] = np.nan  # interior gap
+    holes[0, 0] = np.nan  # corner: outside the convex hull of the valid samples -> nearest
+    lin = read_heights(holes, spacing=(dx, dy), fill="linear")
+    inside = np.ones(h.shape, bool)
+    inside[0, 0] = False
+    np.testing.assert_allclose(lin.heights[inside], h[inside], rtol=0, atol=1e-12)
+    assert lin.heights[0, 0] == h[0, 1]
+    near = read_heights(holes, spacing=(dx, dy), fill="nearest")
+    # (2, 2): neighbour in x is 1 away, in y 10 away -> takes (2, 1); (2, 3) takes (2, 4)
+    assert near.heights[2, 2] == h[2, 1] and near.heights[2, 3] == h[2, 4]
+    assert near.heights[0, 0] == h[0, 1]
+
+
+# ---- pyvista ImageData ---------------------------------------------------------------------------------
+def image(nx=4, ny=3, spacing=(0.5, 2.0, 1.0), origin=(5e5, 5.1e6, 0.0)):
+    img = pv.ImageData(dimensions=(nx, ny, 1), spacing=spacing, origin=origin)
+    h = np.arange(nx * ny, dtype=np.float64).reshape(ny, nx) ** 1.5
+    img.point_data["elev"] = h.ravel()
+    return img, h
+
+
+def test_imagedata_anisotropic_utm_exact():
+    img, h = image()
+    g = read_heights(img)
+    assert g.spacing == (0.5, 2.0) and g.origin == (500000.0, 5100000.0)
+    assert np.array_equal(g.heights, h) and g.source == "pyvista.ImageData"
+    # the raw vtk object works too
+    assert np.array_equal(read_heights(img.copy()).heights, h)
+
+
+def test_imagedata_named_scalars_and_errors():
+    img, h = image()
+    img.point_data["other"] = np.zeros(img.n_points)
+    img.set_active_scalars("other")
+    assert np.array_equal(read_heights(img, scalars="elev").heights, h)
+    with pytest.raises(ValueError, match=r"no point array named 'height'; point arrays: \['elev', 'other'\]"):
+        read_heights(img, scalars="height")
+    with pytest.raises(ValueError, match=r"carries its own spacing and origin; spacing= would override"):
+        read_heights(img, spacing=(1, 1))
+    empty = pv.ImageData(dimensions=(3, 3, 1))
+    with pytest.raises(ValueError, match=r"no active point scalars; pass scalars="):
+        read_heights(empty)
+    vol = pv.ImageData(dimensions=(3, 4, 5))
+    vol.point_data["h"] = np.zeros(vol.n_points)
+    with pytest.raises(ValueError, match=r"one x-y slice, dims \(nx, ny, 1\); got dims \(3, 4, 5\)"):
+        read_heights(vol)
+    rot = pv.ImageData(dimensions=(3, 3, 1), direction_matrix=[[0, -1, 0], [1, 0, 0], [0, 0, 1]])
+    rot.point_data["h"] = np.zeros(9)
+    with pytest.raises(ValueError, match=r"direction matrix .* is not the identity; only axis-aligned"):
+        read_heights(rot)
+
+
+def test_vti_file_round_trip(tmp_path):
+    img, h = image()
+    path = tmp_path / "terrain.vti"
+    img.save(path)
+    g = read_heights(path)
+    assert g.spacing == (0.5, 2.0) and g.origin == UTM and np.array_equal(g.heights, h)
+    assert g.source == str(path)
+
+
+# ---- RectilinearGrid / StructuredGrid ------------------------------------------------------------------
+def test_rectilinear_uniform_and_decreasing():
+    x = 1000.0 + np.arange(5) * 2.0
+    y = 2000.0 + np.arange(4) * 0.5
+    h = np.arange(20.0).reshape(4, 5)
+    grid = pv.RectilinearGrid(x, y, [0.0])
+    grid.point_data["h"] = h.ravel()
+    g = read_heights(grid)
+    assert g.spacing == (2.0, 0.5) and g.origin == (1000.0, 2000.0) and np.array_equal(g.heights, h)
+    rev = pv.RectilinearGrid(x[::-1], y, [0.0])  # x runs east to west
+    rev.point_data["h"] = h.ravel()
+    g2 = read_heights(rev)
+    assert g2.origin == (1000.0, 2000.0) and np.array_equal(g2.heights, h[:, ::-1])
+
+
+def test_float32_utm_coordinates_count_as_uniform_and_other_types_are_refused(tmp_path):
+    x = (5e5 + np.arange(6) * 1.0).astype(np.float32) + np.float32([0, 0, 0.03125, 0, 0, 0])  # float32 rounding
+    y = (5.1e6 + np.arange(3) * 2.0).astype(np.float32)
+    grid = pv.RectilinearGrid(x, y, np.zeros(1, np.float32))
+    grid.point_data["h"] = np.arange(18.0)
+    g = read_heights(grid)
+    assert g.spacing == (1.0, 2.0) and g.origin == UTM
+    with pytest.raises(TypeError, match=r"pyvista.PolyData is not supported; heights come from ImageData"):
+        read_heights(pv.Sphere())
+    pv.Sphere().save(tmp_path / "s.vtk")
+    with pytest.raises(TypeError, match=r"s\.vtk is not supported"):
+        read_heights(tmp_path / "s.vtk")
+
+
+def test_rectilinear_non_uniform_errors_then_resamples():
+    x = np.array([0.0, 1.0, 2.0, 4.0, 6.0])  # steps 1, 1, 2, 2 -> mean 1.5, worst deviation 1/3
+    y = np.array([10.0, 11.0, 12.0])
+    grid = pv.RectilinearGrid(x, y, [0.0])
+    grid.point_data["h"] = (3.0 + 2.0 * x[None, :] - 0.5 * (y[:, None] - 10.0)).ravel()
+    with pytest.raises(ValueError, match=r"x coordinates are not uniformly spaced \(largest relative deviation "
+                                         r"of a step from the mean step: 0.333\).*Pass resample=True"):
+        read_heights(grid)
+    g = read_heights(grid, resample=True)
+    # smallest step 1 -> 6 steps over [0, 6]
+    assert g.shape == (3, 7) and g.spacing == (1.0, 1.0) and g.origin == (0.0, 10.0)
+    np.testing.assert_allclose(g.heights, plane(7, 3), atol=1e-12)
+
+
+def test_structured_grid_surface_and_flat_with_scalars():
+    x, y = np.meshgrid(300.0 + np.arange(4) * 3.0, 50.0 + np.arange(3) * 1.5)
+    z = x * 0.1 + y
+    surf = pv.StructuredGrid(x, y, z)
+    g = read_heights(surf)
+    assert g.spacing == (3.0, 1.5) and g.origin == (300.0, 50.0)
+    np.testing.assert_array_equal(g.heights, z)
+    flat = pv.StructuredGrid(x, y, np.zeros_like(x))
+    flat.point_data["elev"] = z.ravel(order="F")  # pyvista orders points like x.ravel(order="F")
+    np.testing.assert_array_equal(read_heights(flat).heights, z)
+    # VTK's i axis along x (arrays shaped (nx, ny) as pyvista expects): same result
+    ij = pv.StructuredGrid(x.T, y.T, z.T)
+    assert ij.dimensions == (4, 3, 1)
+    g2 = read_heights(ij)
+    assert g2.spacing == (3.0, 1.5) and g2.origin == (300.0, 50.0)
+    np.testing.assert_array_equal(g2.heights, z)
+    surf.point_data["elev"] = z.ravel()
+    with pytest.raises(ValueError, match=r"scalars='elev' given but the points' z varies"):
+        read_heights(surf, scalars="elev")
+    c, s = np.cos(0.3), np.sin(0.3)
+    rot = pv.StructuredGrid(c * x - s * y, s * x + c * y, z)
+    with pytest.raises(ValueError, match=r"not an axis-aligned lattice"):
+        read_heights(rot)
+
+
+# ---- files: common errors --------------------------------------------------------------------------------
+def test_missing_file_and_unknown_extension(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"height file not found: .*nothere\.dem"):
+        read_heights(tmp_path / "nothere.dem")
+    (tmp_path / "h.csv").write_text("1,2\n3,4\n")
+    with pytest.raises(ValueError, match=r"h\.csv: extension '\.csv' is not supported; supported: \.vti .*\.tiff"):
+        read_heights(str(tmp_path / "h.csv"))
+    (tmp_path / "bad.dem").write_text("too short")
+    with pytest.raises(ValueError, match=r"bad\.dem: too short for a USGS ASCII DEM \(9 bytes"):
+        read_heights(tmp_path / "bad.dem")
+
+
+# ---- USGS ASCII DEM ---------------------------------------------------------------------------------------
+# Precision of the format: corners D24.15 (16 significant digits), spacing E12.6 (7 significant
+# digits), elevations integers times z_resolution (0.01 m here): heights within z_resolution / 2.
+@pytest.mark.parametrize("nx", [6, 100])  # 6: parsed in Python (VTK 9.7.1 divides by zero < 100), 100: vtkDEMReader
+def test_usgs_dem_round_trip(tmp_path, nx):
+    ny = 7
+    h = 250.0 + 0.123 * plane(nx, ny, 30.0, 10.0) + 17.0 * np.sin(np.arange(nx))[None, :]
+    path = write_usgs_ascii_dem(tmp_path / "t.dem", h, (30.0, 10.0), UTM, z_resolution=0.01)
+    g = read_heights(path)
+    assert g.shape == (ny, nx) and g.spacing == (30.0, 10.0) and g.origin == UTM
+    assert g.crs == "UTM zone 33 (x, y in m)" and g.units == "m"
+    assert np.abs(g.heights - h).max() <= 0.005 + 1e-9
+    # exactly the stored integers times the resolution
+    np.testing.assert_array_equal(g.heights, np.rint(h / 0.01) * 0.01)
+
+
+def test_usgs_dem_void_is_reported_with_file_position(tmp_path):
+    h = plane(100, 3, 30.0, 10.0) + 100.0
+    h[1, 7] = np.nan
+    path = write_usgs_ascii_dem(tmp_path / "v.dem", h, (30.0, 10.0), UTM)
+    with pytest.raises(ValueError, match=r"v\.dem: 1 of 300 samples are missing.*\(row, col\) = \(1, 7\) \[row counted "
+                                         r"from the south, column = profile\], \(x, y\) = \(500210.0, 5100010.0\)"):
+        read_heights(path)
+    g = read_heights(path, fill="linear")
+    np.testing.assert_allclose(g.heights[1, 7], 100.0 + plane(100, 3, 30.0, 10.0)[1, 7], atol=0.002)
+    assert DEM_VOID == -32767
+
+
+def test_dem_writer_refuses_float32_inexact_geometry(tmp_path):
+    with pytest.raises(ValueError, match=r"vtkDEMReader would count .* samples in x"):
+        write_usgs_ascii_dem(tmp_path / "x.dem", np.zeros((3, 200)), (0.1, 1.0), (5e5 + 0.05, 5.1e6))
+
+
+# ---- GeoTIFF ---------------------------------------------------------------------------------------------
+def test_geotiff_north_up_ramp_flipped_and_exact(tmp_path):
+    ny, nx = 5, 3
+    h = np.repeat(np.arange(ny, dtype=np.float64)[:, None] * 10.0, nx, axis=1)  # increases to the north
+    path = write_geotiff(tmp_path / "r.tif", h, (2.0, 3.0), UTM, epsg=32633)
+    stored = tifffile.imread(path)
+    assert stored[0, 0] == 40.0  # the file stores the northern row first
+    g = read_heights(path)
+    assert np.all(np.diff(g.heights[:, 0]) > 0)  # increasing with j = northwards
+    assert np.array_equal(g.heights, h) and g.spacing == (2.0, 3.0) and g.origin == UTM
+    assert g.crs == "EPSG:32633"
+
+
+def _tiff(path, data, tie, scale=None, raster_type=1, transform=None):
+    tags = [(34735, "H", 8, (1, 1, 0, 1, 1025, 0, 1, raster_type), False)]
+    if transform is not None:
+        tags.append((34264, "d", 16, tuple(transform), False))
+    else:
+        tags += [(33550, "d", 3, scale, False), (33922, "d", 6, tie, False)]
+    tifffile.imwrite(path, np.asarray(data, dtype=np.float32), extratags=tags, metadata=None)
+    return path
+
+
+def test_geotiff_pixel_is_area_shifts_origin_by_half_a_pixel(tmp_path):
+    data = np.arange(6, dtype=np.float32).reshape(3, 2)  # row 0 north
+    tie, scale = (0, 0, 0, 1000.0, 2000.0, 0), (10.0, 20.0, 0.0)
+    area = read_heights(_tiff(tmp_path / "a.tif", data, tie, scale, raster_type=1))
+    # centre of the south-west pixel: x = 1000 + 0.5*10, y = 2000 - 2.5*20
+    assert area.origin == (1005.0, 1950.0) and area.spacing == (10.0, 20.0)
+    point = read_heights(_tiff(tmp_path / "p.tif", data, tie, scale, raster_type=2))
+    assert point.origin == (1000.0, 1960.0)
+    np.testing.assert_array_equal(area.heights, data[::-1])
+    # the writer puts the tiepoint on the pixel corner for PixelIsArea
+    path = write_geotiff(tmp_path / "w.tif", np.zeros((3, 2)), (10.0, 20.0), (1005.0, 1950.0))
+    with tifffile.TiffFile(path) as tif:
+        assert tif.pages[0].tags[33922].value == (0.0, 0.0, 0.0, 1000.0, 2000.0, 0.0)
+    assert read_heights(path).origin == (1005.0, 1950.0)
+
+
+def test_geotiff_nodata_message_and_fill(tmp_path):
+    h = plane(4, 3, 2.0, 3.0)
+    h[0, 1] = np.nan  # south row -> stored row 2
+    path = write_geotiff(tmp_path / "n.tif", h, (2.0, 3.0), UTM, nodata=-9999.0, dtype=np.float32)
+    with pytest.raises(ValueError, match=r"n\.tif: 1 of 12 samples are missing.*\(row, col\) = \(2, 1\) \[\(row, col\) "
+                                         r"as stored, row 0 = north\], \(x, y\) = \(500002.0, 5100000.0\), value "
+                                         r"-9999.0. Pass fill='nearest' or fill='linear'"):
+        read_heights(path)
+    g = read_heights(path, fill="linear")
+    np.testing.assert_allclose(g.heights, plane(4, 3, 2.0, 3.0), atol=1e-5)
+
+
+def test_geotiff_rotation_plain_tiff_and_overrides(tmp_path):
+    m = [1.0, 0.2, 0, 100.0, 0.1, -1.0, 0, 200.0, 0, 0, 0, 0, 0, 0, 0, 1]
+    with pytest.raises(ValueError, match=r"rot\.tif: ModelTransformationTag has rotation/shear terms \(0.2, 0.1\)"):
+        read_heights(_tiff(tmp_path / "rot.tif", np.zeros((2, 2)), None, transform=m))
+    plain = tmp_path / "plain.tif"
+    tifffile.imwrite(plain, np.array([[2.0, 3.0], [0.0, 1.0]]))
+    with pytest.raises(ValueError, match=r"plain\.tif: no GeoTIFF georeferencing .* pass spacing= and origin="):
+        read_heights(plain)
+    g = read_heights(plain, spacing=(1, 1), origin=(0, 0))
+    np.testing.assert_array_equal(g.heights, [[0.0, 1.0], [2.0, 3.0]])
+    geo = write_geotiff(tmp_path / "geo.tif", np.zeros((2, 2)), (1.0, 1.0), (0.0, 0.0))
+    with pytest.raises(ValueError, match=r"geo\.tif \(georeferenced\) carries its own spacing and origin"):
+        read_heights(geo, origin=(5.0, 5.0))
+
+
+# ---- synthetic terrain -------------------------------------------------------------------------------------
+def test_fractal_terrain_reproducible_and_scaled():
+    z = fractal_terrain(32, seed=3, amplitude=100.0)
+    assert z.shape == (32, 32) and z.min() == 0.0 and z.max() == pytest.approx(100.0, rel=1e-12)
+    assert np.array_equal(z, fractal_terrain(32, seed=3, amplitude=100.0))
+    with pytest.raises(ValueError, match=r"n must be an integer >= 2, got 1"):
+        fractal_terrain(1)
