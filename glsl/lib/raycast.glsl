@@ -26,16 +26,19 @@ uniform float sv_ambient;     // lighting weights (lib/effects/lights.glsl)
 uniform float sv_diffuse;
 
 // The viewing ray through this fragment: origin, unit direction and the smallest admissible parameter.
-// Perspective rays start at the eye (t >= 0); parallel rays pass through the fragment from -infinity.
+// The origin is the fragment's own position on the proxy (its far side), not the eye: everything the
+// program computes then involves coordinates of the size of the proxy, and a distant eye (a grazing view
+// across a terrain from kilometres away) costs no float32 precision. Perspective rays start at the eye,
+// which lies at t = -|pos - eye|; parallel rays come from -infinity.
 void sv_pixel_ray(vec3 pos_mc, out vec3 ro, out vec3 rd, out float tmin) {
+    ro = pos_mc;
     if (sv_parallel == 1) {
         rd = sv_view_dir_mc;
-        ro = pos_mc;
         tmin = -3.0e38;
     } else {
-        ro = sv_eye_mc;
-        rd = normalize(pos_mc - sv_eye_mc);
-        tmin = 0.0;
+        vec3 v = pos_mc - sv_eye_mc;
+        rd = normalize(v);
+        tmin = -length(v);
     }
 }
 

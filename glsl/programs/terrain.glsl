@@ -48,7 +48,14 @@ vec3 sv_cell_bary(vec2 p, int tri) {
     return tri == 0 ? vec3(1.0 - p.x, p.x - p.y, p.y) : vec3(1.0 - p.y, p.x, p.y - p.x);
 }
 
-// First hit of the cell-local ray (o + t d) with triangle `tri` for t in [ta, tb]; -1 if none.
+// First hit of the cell-local ray (o + t d) with triangle `tri` for t in [ta, tb]; 3e38 if none
+// (t may be negative: rays start on the far side of the proxy, see lib/raycast.glsl).
+const float SV_NO_HIT = 3.0e38;
+// Cells and triangles are clipped with a margin of 2^-16 of a cell (about 8 ulps of cell-local
+// coordinates of size ~30): a root on a shared edge, which float32 rounding could push out of both
+// neighbours' segments (a crack), is then found by at least one of them. Inside the margin the
+// triangle's polynomial is its own extension, which meets the neighbour continuously (C0 at least).
+const float SV_CELL_MARGIN = 1.52587890625e-05;
 float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
     vec3 lo = sv_cell_bary(o.xy, tri);
     vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
@@ -56,9 +63,9 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) 
     float t1 = tb;
     for (int k = 0; k < 3; ++k) {
         if (abs(ld[k]) < 1e-30) {
-            if (lo[k] < 0.0) return -1.0;
+            if (lo[k] < -SV_CELL_MARGIN) return SV_NO_HIT;
         } else {
-            float tc = -lo[k] / ld[k];
+            float tc = (-SV_CELL_MARGIN - lo[k]) / ld[k];
             if (ld[k] > 0.0) t0 = max(t0, tc); else t1 = min(t1, tc);
         }
     }
@@ -66,21 +73,21 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) 
     float zhi = b[0];
     for (int q = 1; q < 15; ++q) { zlo = min(zlo, b[q]); zhi = max(zhi, b[q]); }
     if (abs(d.z) < 1e-30) {
-        if (o.z < zlo || o.z > zhi) return -1.0;
+        if (o.z < zlo || o.z > zhi) return SV_NO_HIT;
     } else {
         float za = (zlo - o.z) / d.z;
         float zb = (zhi - o.z) / d.z;
         t0 = max(t0, min(za, zb));
         t1 = min(t1, max(za, zb));
     }
-    if (!(t0 <= t1)) return -1.0;
+    if (!(t0 <= t1)) return SV_NO_HIT;
     float c[5];
     sv_restrict_quartic_tri(b, lo + t0 * ld, lo + t1 * ld, c);
     float z0 = o.z + t0 * d.z;
     float z1 = o.z + t1 * d.z;
     for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
     float s = sv_first_root(c, 4, sv_newton_iterations);
-    return s < 0.0 ? -1.0 : mix(t0, t1, s);
+    return s < 0.0 ? SV_NO_HIT : mix(t0, t1, s);
 }
 
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
@@ -109,7 +116,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     int L = sv_top_level;
     ivec2 c = ivec2(0);
     ivec2 stepdir = ivec2(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1);
-    float t_hit = -1.0;
+    float t_hit = SV_NO_HIT;
     ivec2 cell_hit = ivec2(0);
     for (int s = 0; s < sv_max_steps; ++s) {
         float size = float(1 << L);
@@ -134,10 +141,12 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             float b1[15];
             sv_load_cell(c, b0, b1);
             vec3 o = vec3(P0.xy - vec2(c), P0.z);
-            float h0 = sv_triangle_hit(b0, 0, o, D, t, tb);
-            float h1 = sv_triangle_hit(b1, 1, o, D, t, tb);
-            float th = h0 < 0.0 ? h1 : (h1 < 0.0 ? h0 : min(h0, h1));
-            if (th >= 0.0) {
+            // the cell's segment, widened by the margin (in t) on both ends
+            float dt_margin = SV_CELL_MARGIN / max(max(abs(D.x), abs(D.y)), 1e-30);
+            float h0 = sv_triangle_hit(b0, 0, o, D, t - dt_margin, tb + dt_margin);
+            float h1 = sv_triangle_hit(b1, 1, o, D, t - dt_margin, tb + dt_margin);
+            float th = min(h0, h1);
+            if (th < SV_NO_HIT) {
                 t_hit = th;
                 cell_hit = c;
                 break;
@@ -156,7 +165,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             c = c / 2;
         }
     }
-    if (t_hit < 0.0) return false;
+    if (t_hit == SV_NO_HIT) return false;
 
     hit.t = t_hit;
     hit.pos = ro + t_hit * rd;

@@ -34,16 +34,21 @@ def _bound(model, matrix, o, d, t):
     from ..analytic import QuarticTrianglePatch
 
     p = o + t[..., None] * d
+    # The shader's rays start on the far side of the proxy (lib/raycast.glsl), so the coordinates it
+    # rounds are bounded by the proxy's extent in the frame the program works in.
     if isinstance(model, QuarticTrianglePatch):
+        extent = np.abs(model.vertices).max(axis=0)
         return ray_depth_error_bound(lambda q: model.gradient(q), float(np.abs(model.coefficients).max()), matrix,
-                                     o, d, t, np.abs(p[..., :2]))
+                                     o, d, t, np.broadcast_to(extent, p[..., :2].shape),
+                                     proxy_size=float(np.ptp(model.vertices, axis=0).max() + np.ptp(model.zrange)))
     # terrain: the shader works in the model frame (world - offset) and in index coordinates
     off = model.offset
     o_mc = o - off
-    coord = np.abs(p[..., :2] - np.asarray(model.origin))
+    x0, x1, y0, y1 = model.extent
+    coord = np.broadcast_to(np.array([x1 - x0, y1 - y0]), p[..., :2].shape)  # index coordinates, physical units
     return ray_depth_error_bound(lambda q: model.gradient(q[..., 0] + off[0], q[..., 1] + off[1]),
                                  float(np.abs(model.coefficients).max()), _shift(matrix, off),
-                                 o_mc, d, t, coord)
+                                 o_mc, d, t, coord, proxy_size=float(max(x1 - x0, y1 - y0, np.ptp(model.zrange))))
 
 
 def _shift(matrix, off):

@@ -12,7 +12,8 @@ __all__ = ["U32", "ray_depth_error_bound"]
 U32 = 2.0 ** -24
 
 
-def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, coord_magnitude) -> np.ndarray:
+def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, coord_magnitude,
+                          proxy_size: float = 0.0) -> np.ndarray:
     """Per-pixel bound on |GPU depth - float64 depth| for graph surfaces z = f(x, y) hit at ray parameters t.
 
     Derivation (float32 arithmetic, unit roundoff u = 2^-24):
@@ -24,12 +25,22 @@ def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, co
     * The barycentric/index coordinates of the ray are computed in float32 from coordinates of size
       ``coord_magnitude`` = (|X|, |Y|) (physical units): an error of 4 u |X| in x moves f by |f_x| times
       that, so eps_x = 4 u (|X| |f_x| + |Y| |f_y|).
-    * The root finder stops at a zero of the computed g, so the root moves by at most
-      (eps_f + eps_x) / |g'(t)| with g'(t) = grad f . d_xy - d_z (first-order perturbation of a simple
-      root). Window depth moves by |d'(t)| times that; computing depth from clip coordinates costs
-      8 u more and the depth buffer quantizes to 2^-24.
+    * The ray itself is rounded: it starts at the fragment's interpolated position on the proxy (a few
+      roundings of coordinates bounded by the proxy's size P) and its direction is normalized in float32
+      (relative error ~ 3 u, i.e. a sideways shift of 3 u per unit of length travelled, at most P inside
+      the proxy). Together a sideways shift of 8 u P, which moves the height difference g by
+      eps_r = 8 u P (1 + |grad f|).
+    * The root finder stops at a zero of the computed g = g + e with |e| <= eps. Taylor with
+      g'(t) = grad f . d_xy - d_z and g'' = d_xy^T H d_xy: if 2 |g''| eps < g'^2, the perturbed root
+      lies within 2 eps / |g'| (the smaller root of |g'| x - |g''| x^2 / 2 = eps is below that);
+      otherwise the root is ill-conditioned (near tangential ray, a near double root) and moves by up
+      to 2 sqrt(2 eps / |g''|). Window depth moves by |d'(t)| times that.
+    * Depth from clip coordinates: clip z and w are 4-term dot products (error 4 u sum_j |M_ij p_j|
+      each), so ndc z = z/w is off by 4 u (sum_j |M_2j p_j| + |ndc z| sum_j |M_3j p_j|) / |w| + u, and
+      window depth by half that plus one rounding; the depth buffer quantizes to 2^-24.
 
-    Near tangential rays g' -> 0 and the bound grows, as the problem's condition does.
+    Near tangential rays g' -> 0 and the bound grows, as the problem's condition does. g'' is taken by
+    central differences of g' in float64 (relative error ~1e-4, immaterial at this scale).
     """
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
@@ -39,7 +50,24 @@ def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, co
     eps_f = 32.0 * U32 * (coef_max + np.abs(p[..., 2]))
     cm = np.asarray(coord_magnitude, dtype=np.float64)
     eps_x = 4.0 * U32 * np.einsum("...i,...i->...", cm, np.abs(grad))
-    dt = (eps_f + eps_x) / np.maximum(gprime, 1e-300)
+    eps_r = 8.0 * U32 * proxy_size * (1.0 + np.linalg.norm(grad, axis=-1))
+    eps = eps_f + eps_x + eps_r
     h = 1e-6 * np.maximum(1.0, np.abs(t))
+
+    def slope(tt):
+        q = o + tt[..., None] * d
+        return np.einsum("...i,...i->...", gradient(q[..., :2]), d[..., :2]) - d[..., 2]
+
+    gsecond = np.abs(slope(t + h) - slope(t - h)) / (2 * h)
+    simple = 2.0 * gsecond * eps < gprime ** 2
+    dt = np.where(simple, 2.0 * eps / np.maximum(gprime, 1e-300),
+                  2.0 * np.sqrt(2.0 * eps / np.maximum(gsecond, 1e-300)))
     dd_dt = np.abs(window_depth(matrix, o + (t + h)[..., None] * d) - window_depth(matrix, o + (t - h)[..., None] * d)) / (2 * h)
-    return dd_dt * dt + 8.0 * U32 + 2.0 ** -24
+    m = np.asarray(matrix, dtype=np.float64)
+    ph = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1)
+    w = ph @ m[3]
+    ndc = (ph @ m[2]) / w
+    s2 = np.abs(ph * m[2]).sum(axis=-1)
+    s3 = np.abs(ph * m[3]).sum(axis=-1)
+    depth_arith = 0.5 * (4.0 * U32 * (s2 + np.abs(ndc) * s3) / np.abs(w) + U32) + U32
+    return dd_dt * dt + depth_arith + 2.0 ** -24

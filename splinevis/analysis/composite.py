@@ -86,8 +86,10 @@ def depth_error_bound(patch, matrix, origins, directions, t) -> np.ndarray:
     """Per-pixel bound on |GPU depth - float64 depth| for the analytic patch (see
     :func:`splinevis.analysis.bounds.ray_depth_error_bound`)."""
     p = np.asarray(origins) + t[..., None] * np.asarray(directions)
+    extent = np.abs(patch.vertices).max(axis=0)  # rays start on the proxy: coordinates are bounded by it
     return ray_depth_error_bound(lambda q: patch.gradient(q), float(np.abs(patch.coefficients).max()), matrix,
-                                 origins, directions, t, np.abs(p[..., :2]))
+                                 origins, directions, t, np.broadcast_to(extent, p[..., :2].shape),
+                                 proxy_size=float(np.ptp(patch.vertices, axis=0).max() + np.ptp(patch.zrange)))
 
 
 def patch_depth_agreement(window_size=(640, 480), camera=None, newton_iterations=6) -> dict:
