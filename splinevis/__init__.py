@@ -16,7 +16,11 @@ from .errors import (
     SplinevisError as SplinevisError,
 )
 
-__all__ = ["Style", "Plotter", "SplinevisError", "OpenGLUnavailableError", "ShaderCompileError", "__version__"]
+from .io import HeightGrid as HeightGrid, read_heights as read_heights
+from .terrain.model import TerrainSpline as TerrainSpline
+
+__all__ = ["Style", "Plotter", "TerrainSpline", "HeightGrid", "read_heights", "SplinevisError",
+           "OpenGLUnavailableError", "ShaderCompileError", "__version__"]
 
 
 def __getattr__(name):

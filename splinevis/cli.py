@@ -1,4 +1,4 @@
-"""The ``splinevis`` command: ``info``, ``selftest``, ``demo``.
+"""The ``splinevis`` command: ``info``, ``selftest``, ``demo``, ``study terrain``.
 
 Exit codes: 0 success, 1 the job ran and failed (selftest over its bounds), 2 bad usage, 3 no OpenGL.
 """
@@ -58,6 +58,19 @@ def _cmd_demo(args) -> int:
     return 0
 
 
+def _cmd_study(args) -> int:
+    if args.name == "terrain":
+        from .studies.terrain import run_terrain_study
+
+        result = run_terrain_study(args.out, quick=args.quick, progress=not args.quiet)
+        out = Path(args.out)
+        for f in sorted(out.glob("*.md")) + sorted(out.glob("*.png")):
+            print(f)
+        print(out / "terrain.json")
+        return 0 if result else 1
+    raise ValueError(f"study {args.name!r} is not known; choose 'terrain'.")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="splinevis", description="Exact per-pixel rendering of spline models.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -74,6 +87,12 @@ def main(argv=None) -> int:
     p.add_argument("--out", required=True, help="directory for the PNG figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_demo)
+    p = sub.add_parser("study", help="run a study (accuracy vs time) and write JSON, tables and figures")
+    p.add_argument("name", choices=["terrain"])
+    p.add_argument("--out", required=True, help="directory for the study's files")
+    p.add_argument("--quick", action="store_true", help="smaller sizes: a few minutes")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_study)
     args = parser.parse_args(argv)
     from .errors import OpenGLUnavailableError
 

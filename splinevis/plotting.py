@@ -124,9 +124,34 @@ class Plotter(pv.Plotter):
         st = _style_from(style, style_options)
         spec = _builder_for(model)(model, newton_iterations=newton_iterations, **(program_options or {}))
         spline = SplineActor(spec, st, self.renderer)
+        spline.model = model
         self.add_actor(spline.actor, name=name, reset_camera=True)
         self._spline_actors.append(spline)
         return spline
+
+    def add_terrain(self, heights, scheme: str = "C1", style: Style | None = None, *, read_options: dict | None = None,
+                    **options):
+        """Build a terrain spline from height data and add it (see :meth:`add_spline` for ``options``).
+
+        ``heights`` is anything :func:`splinevis.io.read_heights` reads (2-D array, pyvista grid, VTK
+        file, USGS DEM, GeoTIFF) or a :class:`~splinevis.io.HeightGrid`; ``scheme`` one of
+        ``linear, C0, C1, C2, C2-cubic``. Returns the :class:`SplineActor`; its ``model`` attribute is
+        the :class:`~splinevis.terrain.TerrainSpline`.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import splinevis
+        >>> z = np.add.outer(np.sin(np.linspace(0, 3, 33)), np.cos(np.linspace(0, 3, 33)))
+        >>> pl = splinevis.Plotter(off_screen=True, window_size=(200, 150))
+        >>> actor = pl.add_terrain(z, "C2", read_options={"spacing": (0.1, 0.1)}, colormap="terrain")
+        >>> actor.model.num_patches
+        2048
+        """
+        from .terrain.model import TerrainSpline
+
+        model = TerrainSpline.from_heights(heights, scheme, **(read_options or {}))
+        return self.add_spline(model, style, **options)
 
     def render(self) -> None:
         """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`."""

@@ -22,7 +22,8 @@ import numpy as np
 from .bb import roots as _roots
 from .bb import simplex as _simplex
 
-__all__ = ["run_selftest", "gamma_eps", "EVAL_BOUND", "DERIV_BOUND", "RESTRICT_BOUND", "ROOT_BOUND"]
+__all__ = ["run_selftest", "gamma_eps", "EVAL_BOUND", "DERIV_BOUND", "RESTRICT_BOUND", "ROOT_BOUND",
+           "classify_first_roots"]
 
 U32 = 2.0**-24
 EPS32 = 2.0**-23
@@ -213,6 +214,69 @@ def _bern_abs_sum(c, t, n):
     return _simplex._decasteljau(np.abs(c), n, 1, tt)
 
 
+def classify_first_roots(c, x, n: int, absolute_bound: float = 0.0, ref=None) -> dict:
+    """Classify computed first roots ``x`` (NaN = none) of ``c`` (M, n+1) against :func:`roots_reference`.
+
+    A reference first root ``r`` is *well-conditioned* when the linearization behind the residual test
+    holds: ``|f''(r)| K_n u_r <= |f'(r)| / 2`` with ``u_r = eps32 S(r) / |f'(r)|`` (as in the first_root
+    rows). ``x`` *matches* if ``|x - r| <= max(ROOT_BOUND(n) u_r, absolute_bound)`` (``absolute_bound``:
+    the bracket width guaranteed by the method, ``4^-N`` for bracketed Newton). A non-matching
+    ``x < r`` is an ``earlier_near_root`` if it passes the float32 residual test in exact arithmetic,
+    ``|f(x)| <= (K_n + EVAL_BOUND(n)) eps32 S(x)`` (a complex pair near the real axis: indistinguishable
+    from a double root in float32), an ``earlier_root_missed_by_reference`` if ``f`` changes sign (in
+    float64) within ``absolute_bound`` of ``x``, and ``earlier_wrong`` otherwise. Returns boolean masks.
+    """
+    c = np.asarray(c, dtype=np.float64)
+    x = np.asarray(x, dtype=np.float64)
+    if ref is None:
+        ref = _roots.roots_reference(c)
+    rf = ref[:, 0]
+    K = _roots.root_tolerance_k(n)
+
+    def jet(t):
+        tt = np.where(np.isfinite(t), t, 0.5)
+        tt = np.stack([1.0 - tt, tt], axis=-1)
+        f = _simplex._decasteljau(c, n, 1, tt)
+        S = _simplex._decasteljau(np.abs(c), n, 1, tt)
+        fp = n * _simplex._decasteljau(c[:, 1:] - c[:, :-1], n - 1, 1, tt)
+        fpp = (n * (n - 1) * _simplex._decasteljau(c[:, 2:] - 2 * c[:, 1:-1] + c[:, :-2], n - 2, 1, tt)
+               if n >= 2 else np.zeros_like(f))
+        return f, S, fp, fpp
+
+    with np.errstate(all="ignore"):
+        f, S, fp, fpp = jet(rf)
+        ur = EPS32 * S / np.abs(fp)
+        well = np.isfinite(rf) & np.isfinite(ur) & (np.abs(fpp) * K * ur <= 0.5 * np.abs(fp))
+        found = np.isfinite(x)
+        match = well & found & (np.abs(x - rf) <= np.maximum(ROOT_BOUND(n) * ur, absolute_bound))
+        fx, Sx, _, _ = jet(x)
+        near_root = np.abs(fx) <= (K + EVAL_BOUND(n)) * EPS32 * Sx
+        fa, _, _, _ = jet(np.clip(x - absolute_bound, 0.0, 1.0))
+        fb, _, _, _ = jet(np.clip(x + absolute_bound, 0.0, 1.0))
+        sign_change = (fa == 0.0) | (fb == 0.0) | (np.signbit(fa) != np.signbit(fb))
+    earlier = well & found & ~match & (x < rf)
+    return {
+        "well": well,
+        "match": match,
+        "missed": well & ~found,
+        "later": well & found & ~match & (x > rf),
+        "earlier_near_root": earlier & near_root,
+        "earlier_root_missed_by_reference": earlier & ~near_root & sign_change,
+        "earlier_wrong": earlier & ~near_root & ~sign_change,
+        "found_without_reference_root": found & ~np.isfinite(rf),
+    }
+
+
+def _reference_counts(c, x, n, absolute_bound, ref):
+    cl = classify_first_roots(c, x, n, absolute_bound, ref)
+    out = {k: int(v.sum()) for k, v in cl.items() if k != "well"}
+    out = {"well_conditioned_first_roots": int(cl["well"].sum()), **out}
+    out["wrong_root"] = out["later"] + out["earlier_wrong"]
+    out["absolute_bound"] = float(absolute_bound)
+    return out
+
+
+
 # ----------------------------------------------------------------------------------------------------
 # the tests
 # ----------------------------------------------------------------------------------------------------
@@ -262,16 +326,20 @@ def _test_restrict(rng, m, results):
     results["restrict_quartic_tri"] = _summary(err, RESTRICT_BOUND(), coefficients_per_case=5)
 
 
-def _test_roots(rng, m, n, iterations, results):
+def _test_roots(rng, m, n, iterations, results, method="newton4"):
     from .gl.harness import run_glsl
 
     c32, kind = _root_inputs(rng, m, n)
-    body = f"sv_out[0] = sv_first_root({_c5(n=n)}, {n}, {iterations});"
+    if method == "newton4":      # paper 000's method
+        glsl_name, twin, absolute_bound = "sv_first_root_newton4", _roots.newton_secure, 0.0
+    else:                        # bracketed Newton on convex pieces: the bracket is <= 4^-N wide
+        glsl_name, twin, absolute_bound = "sv_first_root_bracketed", _roots.first_root_bracketed, 4.0**-iterations
+    body = f"sv_out[0] = {glsl_name}({_c5(n=n)}, {n}, {iterations});"
     g = run_glsl('#include "lib/roots.glsl"\n', body, c32, 1)[:, 0].astype(np.float64)
     g = np.where(g == -1.0, np.nan, g)
     c = c32.astype(np.float64)
-    tw = _roots.newton_secure(c, iterations)                       # float64 twin
-    em = _roots.newton_secure(c32, iterations, dtype=np.float32)   # float32 emulation (no FMA)
+    tw = twin(c, iterations)                                      # float64 twin
+    em = twin(c32, iterations, dtype=np.float32)                  # float32 emulation (no FMA)
     ref = _roots.roots_reference(c)
     K = _roots.root_tolerance_k(n)
     ev = EVAL_BOUND(n)
@@ -369,6 +437,7 @@ def _test_roots(rng, m, n, iterations, results):
         both_found_same_root=int(same.sum()),
         both_none=int((~gf & ~tf).sum()),
         different_root=split(diff_root, np.zeros(m, bool)),
+        different_but_within_absolute_bound=int((diff_root & (np.abs(g - tw) <= 2.0 * absolute_bound)).sum()),
         glsl_only=split(gonly, near_g),
         twin_only=split(tonly, near_t),
         ill_conditioned={"count": int(ill.sum()),
@@ -380,14 +449,21 @@ def _test_roots(rng, m, n, iterations, results):
                          "note": "f' ~ 0 at the root (double or nearly double roots): bound sqrt(2 (2K+E) eps32 S / |f''|); "
                                  "beyond it the two picked different members of a root cluster"},
         glsl_equals_float32_emulation=int((emu_same).sum()),
+        glsl_bit_identical_to_float32_emulation=int(((np.isnan(g) & np.isnan(em)) | (g == em)).sum()),
         twin_vs_reference=twin_acc,
+        vs_reference={"glsl": _reference_counts(c, g, n, absolute_bound, ref),
+                      "float64_twin": _reference_counts(c, tw, n, absolute_bound, ref),
+                      "note": "well-conditioned reference first roots (classify_first_roots): missed, later root "
+                              "returned (wrong), earlier point accepted by the residual test (near miss), earlier "
+                              "true root the reference missed, earlier non-root (wrong)"},
     )
+    res["method"] = glsl_name
     res["cases"] = int(same.sum())
     unexplained = (res["glsl_only"]["unexplained"] + res["twin_only"]["unexplained"]
                    + res["different_root"]["unexplained"] + res["ill_conditioned"]["unexplained"])
     res["unexplained_total"] = int(unexplained)
     res["pass"] = bool(res["exceeding"] == 0 and unexplained == 0)
-    results[f"first_root_n{n}"] = res
+    results[f"first_root_n{n}" if method == "newton4" else f"first_root_bracketed_n{n}"] = res
 
 
 def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool = True,
@@ -405,7 +481,11 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
     progress : bool
         Show a tqdm progress bar.
     iterations : int
-        Newton steps of ``sv_first_root`` (the paper's 6).
+        Steps of both root finders (the paper's 6; the ray caster's default ``newton_iterations``):
+        ``first_root_n*`` rows test paper 000's ``sv_first_root_newton4`` against
+        :func:`~splinevis.bb.roots.newton_secure`, ``first_root_bracketed_n*`` rows the default
+        ``sv_first_root_bracketed`` against :func:`~splinevis.bb.roots.first_root_bracketed`. Both rows
+        carry ``vs_reference``: miss / wrong-root counts on well-conditioned first roots.
 
     Returns
     -------
@@ -424,6 +504,8 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
     jobs = [(f"eval/deriv n={n}", lambda n=n: _test_eval_deriv(rng, cases, n, results)) for n in range(1, 5)]
     jobs.append(("restrict_quartic_tri", lambda: _test_restrict(rng, cases, results)))
     jobs += [(f"first_root n={n}", lambda n=n: _test_roots(rng, cases, n, iterations, results)) for n in range(2, 5)]
+    jobs += [(f"first_root_bracketed n={n}", lambda n=n: _test_roots(rng, cases, n, iterations, results, "bracketed"))
+             for n in range(2, 5)]
     t0 = time.perf_counter()
     bar = tqdm(jobs, disable=not progress, desc="selftest", unit="fn")
     for label, job in bar:

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from splinevis.bb import de_casteljau, newton_secure, restrict_to_segment
+from splinevis.bb import de_casteljau, first_root_bracketed, newton_secure, restrict_to_segment
 from splinevis.errors import ShaderCompileError
 from splinevis.gl.harness import run_glsl
 
@@ -32,7 +32,7 @@ def test_bernstein_exact_values_at_half():
 def test_first_root_matches_float32_emulation_and_twin():
     rng = np.random.default_rng(1)
     c = (rng.normal(size=(20000, 5)) * 10.0 ** rng.uniform(-3, 3, size=(20000, 1))).astype(np.float32)
-    body = "sv_out[0] = sv_first_root(float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]), 4, 6);"
+    body = "sv_out[0] = sv_first_root_newton4(float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]), 4, 6);"
     g = run_glsl('#include "lib/roots.glsl"\n', body, c, 1)[:, 0]
     g = np.where(g == -1.0, np.nan, g)
     em = newton_secure(c, 6, dtype=np.float32)
@@ -43,6 +43,45 @@ def test_first_root_matches_float32_emulation_and_twin():
     both = np.isfinite(g) & np.isfinite(tw)
     assert (np.isfinite(g) == np.isfinite(tw)).mean() > 0.97
     assert np.median(np.abs(g[both] - tw[both])) < 1e-6
+
+
+def _hard_root_cases(rng, m, n):
+    from splinevis.selftest import _root_inputs
+
+    if n >= 2:
+        c32, _ = _root_inputs(rng, m, n)
+    else:  # lines: random coefficients over 12 decades
+        c32 = (rng.normal(size=(m, 2)) * 10.0 ** rng.uniform(-6, 6, size=(m, 2))).astype(np.float32)
+    special = np.zeros((8, n + 1), np.float32)
+    special[1, :] = 1.0                                     # constant, no root
+    special[2, 0] = -1.0; special[2, n] = 1.0               # sign change, flat middle
+    special[3, n] = 0.0; special[3, 0] = -1.0               # root exactly at 1
+    special[4, 0] = 0.0; special[4, 1:] = 2.0               # root exactly at 0
+    special[5, ::2] = 1e-30; special[5, 1::2] = -1e-30      # tiny alternating
+    special[6, ::2] = 1e37; special[6, 1::2] = -1e37        # huge alternating (n * differences stay finite)
+    special[7, 0] = np.inf                                  # non-finite: no root
+    return np.concatenate([c32, special])
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+@pytest.mark.parametrize("iterations", [1, 6, 8, 16])
+def test_first_root_bracketed_equals_float32_twin_on_hard_cases(n, iterations):
+    c = _hard_root_cases(np.random.default_rng(10 + n), 20_000, n)
+    args = ", ".join(f"sv_in[{k}]" if k <= n else "0.0" for k in range(5))
+    for name in ("sv_first_root_bracketed", "sv_first_root"):   # sv_first_root dispatches to it by default
+        g = run_glsl('#include "lib/roots.glsl"\n', f"sv_out[0] = {name}(float[5]({args}), {n}, {iterations});", c, 1)[:, 0]
+        g = np.where(g == -1.0, np.nan, g)
+        em = first_root_bracketed(c, iterations, dtype=np.float32)
+        # llvmpipe is bit-identical to the float32 twin (same operations in the same order, no FMA contraction)
+        assert np.array_equal(g, em, equal_nan=True), (name, int((~((g == em) | (np.isnan(g) & np.isnan(em)))).sum()))
+
+
+def test_sv_first_root_paper_flag_selects_newton4():
+    c = np.random.default_rng(5).normal(size=(5000, 5)).astype(np.float32)
+    body = "sv_out[0] = sv_first_root(float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]), 4, 6);"
+    g = run_glsl('#include "lib/roots.glsl"\n', body, c, 1, defines={"SV_ROOTS_PAPER_NEWTON": True})[:, 0]
+    ref = run_glsl('#include "lib/roots.glsl"\n', body.replace("sv_first_root(", "sv_first_root_newton4("), c, 1)[:, 0]
+    assert np.array_equal(g, ref)
 
 
 def test_restrict_quartic_tri_matches_twin():

@@ -24,6 +24,7 @@ def test_selftest_full_size(tmp_path):
     assert saved["functions"].keys() == res["functions"].keys()
     names = {f"bernstein_eval_n{n}" for n in range(1, 5)} | {f"bernstein_deriv_n{n}" for n in range(1, 5)}
     names |= {f"first_root_n{n}" for n in range(2, 5)} | {"restrict_quartic_tri"}
+    names |= {f"first_root_bracketed_n{n}" for n in range(2, 5)}
     assert set(res["functions"]) == names
     for name, r in res["functions"].items():
         assert r["max_err_eps"] <= r["bound_eps"], name
@@ -32,6 +33,11 @@ def test_selftest_full_size(tmp_path):
         if name.startswith("first_root"):
             assert r["total_cases"] == 100_000 and r["unexplained_total"] == 0
             assert r["cases"] > 30_000  # well-conditioned cases where both found the same root
+            if name.startswith("first_root_bracketed"):
+                for who in ("glsl", "float64_twin"):
+                    v = r["vs_reference"][who]
+                    assert v["missed"] == 0 and v["wrong_root"] == 0, (name, who, v)
+                assert r["glsl_bit_identical_to_float32_emulation"] == 100_000
         else:
             assert r["cases"] == 100_000
     assert res["pass"] and res["seconds"] < 60

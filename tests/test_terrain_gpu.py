@@ -80,3 +80,19 @@ def test_extreme_zoom_on_one_patch(franke_c2c):
     r = depth_agreement(franke_c2c, [(x - 0.01, y - 0.012, z + 0.01), (x, y, z), (0, 0, 1)],
                         plotter_hook=lambda pl: setattr(pl.camera, "clipping_range", (1e-4, 2.0)))
     _check(r)
+
+
+def test_hierarchy_full_truncated_and_off_give_identical_images(franke_c2c):
+    import splinevis
+
+    images = []
+    for hierarchy in (True, False, 2):
+        pl = splinevis.Plotter(off_screen=True, window_size=(240, 180))
+        pl.add_spline(franke_c2c, lights=1, program_options={"hierarchy": hierarchy})
+        pl.camera_position = [(-0.6, -0.9, 1.4), (0.5, 0.5, 0.3), (0, 0, 1)]
+        pl.reset_camera_clipping_range()
+        images.append(pl.screenshot().astype(int))
+        pl.close()
+    assert (images[0].sum(-1) < 700).mean() > 0.1
+    # Skipping blocks must never change what a pixel shows: same hits, same shading.
+    assert all(np.array_equal(images[0], im) for im in images[1:])

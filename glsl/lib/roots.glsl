@@ -1,11 +1,17 @@
-// First root in [0, 1] of a univariate BB polynomial of degree n <= 4 by Newton iteration from secure
-// starting points (Kalbe, Zeilfelder et al., "High-quality rendering of varying isosurfaces with cubic
-// trivariate C1-continuous splines" / the quartic ray-patch intersection of paper 000, sec. VI, the
-// pseudo-code "x0 = (0, w0, w1, 1); for (i = 0; i < 6; i++) x_{i+1} = x_i - F(x_i)/F'(x_i)").
-// Newton converges to the roots of every convex or concave piece when started at its end points, and
-// the pieces of f on [0, 1] are delimited by 0, the (at most two) inflection points w0 <= w1, and 1.
+// First root in [0, 1] of a univariate BB polynomial of degree n <= 4, two methods:
 //
-// The float64 twin is splinevis.bb.roots.newton_secure; it mirrors this file line by line.
+// * sv_first_root_newton4 -- paper 000's method (Kalbe, Zeilfelder et al., "High-quality rendering of
+//   varying isosurfaces with cubic trivariate C1-continuous splines" / the quartic ray-patch intersection
+//   of paper 000, sec. VI, the pseudo-code "x0 = (0, w0, w1, 1); for (i = 0; i < 6; i++)
+//   x_{i+1} = x_i - F(x_i)/F'(x_i)"): Newton from the secure starting points, residual acceptance.
+//   Measured to return a LATER root than the first one in ~17% of well-conditioned quartic cases with
+//   6 steps (Newton from 0 converges to the first root only linearly while far from it), to miss double
+//   roots, and to overshoot out of [0, 1] when the root sits near s = 1 (ray-caster holes at patch borders).
+// * sv_first_root_bracketed -- bracketed Newton on convex pieces (the default, see below).
+//
+// sv_first_root(c, n, iterations) is the bracketed method unless SV_ROOTS_PAPER_NEWTON is defined.
+// The float64 twins are splinevis.bb.roots.newton_secure and splinevis.bb.roots.first_root_bracketed;
+// they mirror this file line by line.
 #include "lib/bernstein.glsl"
 
 // Acceptance constant K_n (in units of eps32 = 2^-23) of the residual test |f(x)| <= K_n eps32 S(x),
@@ -56,12 +62,12 @@ void sv_inflection_points(float c[5], int n, out float w0, out float w1) {
     }
 }
 
-// Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after `iterations` (1..8)
-// Newton steps from x = (0, w0, w1, 1).  Returns -1.0 when no candidate passes the residual test
+// Paper 000's method.  Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after
+// `iterations` (1..8) Newton steps from x = (0, w0, w1, 1).  Returns -1.0 when no candidate passes the residual test
 // |f(x)| <= K_n eps32 sum_k |c_k| B^n_k(x) (the Python twin returns NaN there).  A start whose
 // derivative is 0, or whose step is not finite, keeps its x.  Nothing is clamped: iterates leaving
 // [0, 1] are simply not accepted.  The zero polynomial returns 0.
-float sv_first_root(float c[5], int n, int iterations) {
+float sv_first_root_newton4(float c[5], int n, int iterations) {
     float w0;
     float w1;
     sv_inflection_points(c, n, w0, w1);
@@ -93,4 +99,151 @@ float sv_first_root(float c[5], int n, int iterations) {
         if (x[i] >= 0.0 && x[i] <= 1.0 && abs(f[i]) <= tol[i]) best = min(best, x[i]);
     }
     return (best <= 1.0) ? best : -1.0;
+}
+
+// ------------------------------------------------------------------------------------------------------
+// Bracketed Newton on convex pieces (the default method).
+//
+// The secure points p0 = 0 <= w0 <= w1 <= p3 = 1 (inflection points; a missing one is replaced by the
+// neighbouring end, so a piece may be empty) split [0, 1] into three pieces on which f'' has constant
+// sign: f is convex or concave on each piece.  The pieces are processed left to right; the first piece
+// yielding a root gives the answer.  On a piece [a, b]:
+//   * |f(a)| <= tol(a) (tol = K_n eps32 sum_k |c_k| B_k, the residual test of the paper's method):
+//     a is a root at float32 precision (this includes f(a) = 0 and the zero polynomial) -> return a.
+//   * sign change f(a) f(b) < 0: a convex (or concave) function with a sign change has EXACTLY one root
+//     in the piece.  If f(b) = 0 there is an earlier root in (a, b) iff f(a) f'(b) > 0 (f crosses zero
+//     before coming back to 0 at b); otherwise b is the first root and the next piece returns it.
+//     The root is found by sv_bracket_newton (below), which keeps a bracket with the sign change.
+//   * no sign change: a root needs an interior extremum on the far side of zero.  Let f(a) > 0 (the
+//     other case is symmetric): a concave piece attains its minimum at an end, so f > 0; a convex piece
+//     has an interior minimum iff f'(a) < 0 < f'(b).  Together (f'' has the sign of f'(b) - f'(a)):
+//         f(a) f'(a) < 0  and  f'(a) f'(b) < 0.
+//     The extremum m (the single root of the monotone f' on the piece) is found by sv_bracket_newton
+//     applied to f'.  If |f(m)| <= tol(m) it is a touching (double) root / tangential ray -> return m;
+//     if f(m) has the opposite sign of f(a), the first root is the unique one in [a, m] -> bracketed
+//     Newton there.  Otherwise the piece has no root.
+//   * after the last piece: |f(1)| <= tol(1) -> return 1.
+// Fixed budget: every bracketed run takes exactly `iterations` steps (no data-dependent loop bounds);
+// per piece at most two runs plus one scalar evaluation, i.e. at most 3 (2 N + 1) + 3 vec4 evaluations.
+#define SV_ROOT_MAX_ITERATIONS 16
+
+// Safeguarded Newton for the single root of g = sum_k g_k B^m_k in [lo, hi] (m >= 0), given the values
+// glo = g(lo) != 0, ghi = g(hi) with a sign change (ghi may be 0) and derivatives dlo, dhi there.
+// sigma: a number with the sign of g'' on the bracket (0 = unknown).  Each of the `iterations` steps
+// evaluates g, g' at four points in one vec4 de Casteljau (the paper's vector arithmetic):
+//   lane 0: the Newton step x - g/g' from the FOURIER end x of the bracket, the end where g has the sign
+//           of g'' (g(x) g''(x) >= 0), so that Newton converges monotonically into the bracket; if it is
+//           not strictly inside (lo, hi) -- or not finite, or sigma = 0 and the end with the smaller |g|
+//           was taken -- the regula falsi point lo + (hi - lo) g(lo) / (g(lo) - g(hi)) is used;
+//   lanes 1..3: the quarter points lo + (hi - lo) (1/4, 1/2, 3/4).
+// The bracket shrinks to the sub-interval with the sign change (a point with g = 0 counts as the hi
+// side).  Accuracy after N steps: the bracket is at most 4^-N (hi - lo) wide in any case (e.g. 1.5e-5 of
+// the piece for N = 8, 2.4e-4 for N = 6), and the Fourier end moves at least as fast as Newton's
+// monotone, eventually quadratic, iteration; in float32 it stops at the rounding level, where the sign
+// of the computed g is unreliable (|g| <= gamma_{3m} sum |g_k| B_k).  The result is one more Newton
+// step from the Fourier end (values already known), replaced by the regula falsi point if it leaves
+// [lo, hi]: always inside the final bracket.
+float sv_bracket_newton(float g[5], int m, float lo, float hi, float glo, float ghi, float dlo, float dhi,
+                        float sigma, int iterations) {
+    for (int it = 0; it < SV_ROOT_MAX_ITERATIONS; ++it) {
+        if (it < iterations) {
+            bool from_lo = (sigma != 0.0) ? ((glo < 0.0) == (sigma < 0.0)) : (abs(glo) <= abs(ghi));
+            float x = from_lo ? lo : hi;
+            float gx = from_lo ? glo : ghi;
+            float dx = from_lo ? dlo : dhi;
+            float xn = x - gx / dx;
+            if (!(xn > lo && xn < hi)) xn = lo + (hi - lo) * (glo / (glo - ghi));
+            float w = hi - lo;
+            vec4 p = vec4(xn, lo + 0.25 * w, lo + 0.5 * w, lo + 0.75 * w);
+            vec4 gp;
+            vec4 dp;
+            sv_bernstein_eval_deriv4(g, m, p, gp, dp);
+            for (int i = 0; i < 4; ++i) {
+                if (p[i] > lo && p[i] < hi) {
+                    if (gp[i] != 0.0 && ((gp[i] < 0.0) == (glo < 0.0))) {
+                        lo = p[i];
+                        glo = gp[i];
+                        dlo = dp[i];
+                    } else {
+                        hi = p[i];
+                        ghi = gp[i];
+                        dhi = dp[i];
+                    }
+                }
+            }
+        }
+    }
+    bool from_lo = (sigma != 0.0) ? ((glo < 0.0) == (sigma < 0.0)) : (abs(glo) <= abs(ghi));
+    float x = from_lo ? lo : hi;
+    float gx = from_lo ? glo : ghi;
+    float dx = from_lo ? dlo : dhi;
+    float xr = x - gx / dx;
+    if (!(xr >= lo && xr <= hi)) xr = lo + (hi - lo) * (glo / (glo - ghi));
+    return xr;
+}
+
+// Bracketed Newton on convex pieces: smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t),
+// n in 0..4, with `iterations` (1..16) steps per bracketed run; -1.0 when there is none (the Python twin
+// returns NaN).  n = 0: 0 if c0 = 0; the zero polynomial returns 0; non-finite coefficients return -1.
+float sv_first_root_bracketed(float c[5], int n, int iterations) {
+    for (int k = 0; k < 5; ++k) {
+        if (k <= n && !(abs(c[k]) <= 3.4028234663852886e38)) return -1.0;
+    }
+    if (n <= 0) return (c[0] == 0.0) ? 0.0 : -1.0;
+    float w0;
+    float w1;
+    sv_inflection_points(c, n, w0, w1);
+    if (!(w0 > 0.0 && w0 < 1.0)) w0 = 0.0;
+    if (!(w1 > 0.0 && w1 < 1.0)) w1 = 1.0;
+    vec4 p = vec4(0.0, w0, w1, 1.0);
+    float ca[5];
+    for (int k = 0; k < 5; ++k) ca[k] = abs(c[k]);
+    // derivative coefficients: f' = sum_k d_k B^{n-1}_k, d_k = n (c_{k+1} - c_k)
+    float d[5];
+    for (int k = 0; k < 4; ++k) d[k] = (k < n) ? float(n) * (c[k + 1] - c[k]) : 0.0;
+    d[4] = 0.0;
+    vec4 f;
+    vec4 fp;
+    vec4 S;
+    vec4 g;
+    vec4 gp;
+    sv_bernstein_eval_deriv4(c, n, p, f, fp);
+    sv_bernstein_eval_deriv4(ca, n, p, S, fp);
+    sv_bernstein_eval_deriv4(d, n - 1, p, g, gp);  // g = f', gp = f'' at the secure points
+    vec4 tol = sv_root_tol_k(n) * SV_ROOT_EPS32 * S;
+    for (int i = 0; i < 3; ++i) {
+        float a = p[i];
+        float b = p[i + 1];
+        float fa = f[i];
+        float fb = f[i + 1];
+        if (abs(fa) <= tol[i]) return a;
+        float sigma = g[i + 1] - g[i];  // has the sign of f'' on the piece
+        bool change = (fb == 0.0) ? (g[i + 1] != 0.0 && ((fa < 0.0) == (g[i + 1] < 0.0)))
+                                  : ((fa < 0.0) != (fb < 0.0));
+        if (change) return sv_bracket_newton(c, n, a, b, fa, fb, g[i], g[i + 1], sigma, iterations);
+        bool dip = g[i] != 0.0 && g[i + 1] != 0.0 && ((fa < 0.0) != (g[i] < 0.0))
+                   && ((g[i] < 0.0) != (g[i + 1] < 0.0));
+        if (dip) {
+            float m = sv_bracket_newton(d, n - 1, a, b, g[i], g[i + 1], gp[i], gp[i + 1], 0.0, iterations);
+            float fm;
+            float fpm;
+            float Sm;
+            float dummy;
+            sv_bernstein_eval_deriv(c, n, m, fm, fpm);
+            sv_bernstein_eval_deriv(ca, n, m, Sm, dummy);
+            if (abs(fm) <= sv_root_tol_k(n) * SV_ROOT_EPS32 * Sm) return m;
+            if ((fm < 0.0) != (fa < 0.0)) return sv_bracket_newton(c, n, a, m, fa, fm, g[i], fpm, sigma, iterations);
+        }
+    }
+    return (abs(f[3]) <= tol[3]) ? 1.0 : -1.0;
+}
+
+// The method the ray-cast programs use: bracketed Newton on convex pieces, or paper 000's 4-start
+// Newton iteration when SV_ROOTS_PAPER_NEWTON is defined (for comparison).
+float sv_first_root(float c[5], int n, int iterations) {
+#ifdef SV_ROOTS_PAPER_NEWTON
+    return sv_first_root_newton4(c, n, iterations);
+#else
+    return sv_first_root_bracketed(c, n, iterations);
+#endif
 }

@@ -113,8 +113,12 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     }
     if (!(t <= t_end)) return false;
 
+    // Start in the top-level block holding the entry point (with the full hierarchy that is the single
+    // root block; a truncated hierarchy, sv_top_level < last level, starts lower: level 0 is a plain
+    // cell-by-cell walk, which the benchmarks use to measure what the hierarchy buys).
     int L = sv_top_level;
-    ivec2 c = ivec2(0);
+    ivec2 c = clamp(ivec2(floor((P0.xy + t * D.xy) / float(1 << L))), ivec2(0),
+                    ivec2(ceil(sv_ncells / float(1 << L))) - ivec2(1));
     ivec2 stepdir = ivec2(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1);
     float t_hit = SV_NO_HIT;
     ivec2 cell_hit = ivec2(0);

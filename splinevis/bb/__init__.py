@@ -2,8 +2,10 @@
 
 from .roots import (
     EPS32 as EPS32,
+    MAX_BRACKET_ITERATIONS as MAX_BRACKET_ITERATIONS,
     MAX_ROOT_DEGREE as MAX_ROOT_DEGREE,
     eval_deriv as eval_deriv,
+    first_root_bracketed as first_root_bracketed,
     first_root_reference as first_root_reference,
     inflection_points as inflection_points,
     newton_secure as newton_secure,
@@ -28,8 +30,8 @@ from .simplex import (
 )
 
 __all__ = [
-    "EPS32", "MAX_DEGREE", "MAX_ROOT_DEGREE", "bernstein_basis", "blossom", "de_casteljau", "degree_of",
-    "derivative", "elevate", "eval_deriv", "first_root_reference", "gradient", "index_of",
+    "EPS32", "MAX_BRACKET_ITERATIONS", "MAX_DEGREE", "MAX_ROOT_DEGREE", "bernstein_basis", "blossom", "de_casteljau", "degree_of",
+    "derivative", "elevate", "eval_deriv", "first_root_bracketed", "first_root_reference", "gradient", "index_of",
     "inflection_points", "multi_indices", "newton_secure", "num_coefficients", "reparametrize",
     "restrict_to_segment", "root_tolerance_k", "roots_reference", "subdivide",
 ]

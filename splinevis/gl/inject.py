@@ -200,6 +200,7 @@ class SplineActor:
         from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
 
         self.spec = spec
+        self.model = None  # set by Plotter.add_spline
         self.style = style
         self.renderer = renderer
         defines = dict(spec.defines)

@@ -425,5 +425,48 @@ def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
         result["scaling"][:-1], [("grid", "grid", "s"), ("patches", "patches", "int"), ("frame min ms", "frame_min_ms", "f1"),
                                  ("frame median ms", "frame_median_ms", "f1"), ("screen covered", "screen_covered", "f2")], _fmt)
         + f"\nratio largest / smallest: {result['scaling'][-1]['ratio_largest_to_smallest']:.2f}\n")
+    rows, xs, profiles = cliff_overshoot()
+    result["cliff"] = rows
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for s, prof in profiles.items():
+        ax.plot(xs, prof, label=s)
+    ax.set_xlim(0.3, 0.7)
+    ax.set_xlabel("x (cliff at x = 0.5, data 0 | 1 on a 17x17 grid)")
+    ax.set_ylabel("spline height")
+    ax.set_title("Step cliff: overshoot of each scheme")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "cliff.png", dpi=110)
+    plt.close(fig)
+    (out / "cliff.md").write_text("# Step cliff (0 | 1)\n\n" + _md_table(
+        rows, [("scheme", "scheme", "s"), ("overshoot above 1", "overshoot", "e"), ("undershoot below 0", "undershoot", "e")], _fmt))
     (out / "terrain.json").write_text(json.dumps(result, indent=2))
     return result
+
+
+def cliff_overshoot(n=17, schemes=("linear", "C0", "C1", "C2", "C2-cubic")):
+    """A unit step cliff along x = 1/2 (heights 0 then 1): max overshoot above 1 and undershoot below 0
+    of each scheme, sampled densely across the cliff. Returns rows and the profiles (for a figure)."""
+    t = np.linspace(0.0, 1.0, n)
+    x, y = np.meshgrid(t, t, indexing="xy")
+    z = (x > 0.5).astype(np.float64)
+    xs = np.linspace(0.0, 1.0, 2001)
+    rows, profiles = [], {}
+    from ..terrain.model import TerrainSpline
+
+    for s in schemes:
+        terr = TerrainSpline.from_heights(z, s, spacing=(1.0 / (n - 1), 1.0 / (n - 1)))
+        prof = terr.evaluate(xs, np.full_like(xs, 0.5 + 0.3 / (n - 1)))
+        grid = np.linspace(0.0, 1.0, 401)
+        gx, gy = np.meshgrid(grid, grid)
+        vals = terr.evaluate(gx.ravel(), gy.ravel())
+        rows.append({"scheme": s, "overshoot": float(max(vals.max() - 1.0, 0.0)),
+                     "undershoot": float(max(-vals.min(), 0.0))})
+        profiles[s] = prof
+    return rows, xs, profiles

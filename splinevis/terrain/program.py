@@ -46,8 +46,12 @@ def minmax_atlas(terrain: TerrainSpline):
     return atlas, offsets
 
 
-def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_steps: int | None = None) -> ProgramSpec:
+def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_steps: int | None = None,
+                    hierarchy: bool | int = True) -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
+
+    ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
+    int caps the top level (what the benchmarks use to measure the hierarchy's effect).
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
@@ -65,6 +69,12 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
     if len(levels) > 16:
         raise ValueError(f"terrain needs {len(levels)} hierarchy levels; at most 16 are supported.")
     atlas, offsets = minmax_atlas(terrain)
+    if hierarchy is True:
+        top = len(levels) - 1
+    elif hierarchy is False:
+        top = 0
+    else:
+        top = check_degree(hierarchy, "hierarchy", low=0, high=len(levels) - 1)
     off = terrain.offset
     x0, x1, y0, y1 = terrain.extent
     cmin, cmax = float(terrain.coefficients.min()), float(terrain.coefficients.max())
@@ -83,7 +93,7 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
         offset=tuple(off),
         uniforms={
             "sv_level_offset[]": level_offsets,
-            "sv_top_level": len(levels) - 1,
+            "sv_top_level": top,
             "sv_ncells": (float(ncx), float(ncy)),
             "sv_index_scale": (1.0 / sx, 1.0 / sy),
             # u = (x_mc + off_x - x0) / sx
