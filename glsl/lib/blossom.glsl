@@ -1,4 +1,5 @@
 // Restriction of a quartic Bernstein-Bezier triangle patch to a segment, by blossoming.
+#include "lib/blossom_steps.glsl"
 //
 // The 15 coefficients b[q] are ordered as splinevis.bb.simplex.multi_indices(4, 2) (lexicographic
 // descending: (4,0,0), (3,1,0), (3,0,1), (2,2,0), (2,1,1), (2,0,2), (1,3,0), ...).  Along the segment
@@ -28,25 +29,28 @@ void sv_blossom_tri_step(float src[15], int m, vec3 l, out float dst[15]) {
     }
 }
 
-// c[k] = blossom(l0^{4-k}, l1^k) of the quartic triangle patch b (k = 0..4).
+// c[k] = blossom(l0^{4-k}, l1^k) of the quartic triangle patch b (k = 0..4): 4 - k steps with l0, then
+// k steps with l1, exactly the order of the float64 twin, unrolled into fixed-degree steps
+// (lib/blossom_steps.glsl) so that no local array is indexed dynamically: 55 three-term combinations.
 void sv_restrict_quartic_tri(float b[15], vec3 l0, vec3 l1, out float c[5]) {
-    float w[15];          // b after j steps with l0 (degree 4 - j)
-    float v[15];
-    float tmp[15];
-    w = b;
-    for (int j = 0; j <= 4; ++j) {
-        // here w holds b after j steps with l0; finish with 4 - j steps with l1 -> c[4 - j]
-        v = w;
-        for (int s = 0; s < 4; ++s) {
-            if (s < 4 - j) {
-                sv_blossom_tri_step(v, 4 - j - s, l1, tmp);
-                v = tmp;
-            }
-        }
-        c[4 - j] = v[0];
-        if (j < 4) {
-            sv_blossom_tri_step(w, 4 - j, l0, tmp);
-            w = tmp;
-        }
-    }
+    float a1[10];
+    float a2[6];
+    float a3[3];
+    float t10[10];
+    float t6[6];
+    float t3[3];
+    sv_tri_step4(b, l0, a1);                // one step with l0
+    sv_tri_step3(a1, l0, a2);               // two
+    sv_tri_step2(a2, l0, a3);               // three
+    c[0] = sv_tri_step1(a3, l0);            // l0^4
+    c[1] = sv_tri_step1(a3, l1);            // l0^3 l1
+    sv_tri_step2(a2, l1, t3);
+    c[2] = sv_tri_step1(t3, l1);            // l0^2 l1^2
+    sv_tri_step3(a1, l1, t6);
+    sv_tri_step2(t6, l1, t3);
+    c[3] = sv_tri_step1(t3, l1);            // l0 l1^3
+    sv_tri_step4(b, l1, t10);
+    sv_tri_step3(t10, l1, t6);
+    sv_tri_step2(t6, l1, t3);
+    c[4] = sv_tri_step1(t3, l1);            // l1^4
 }

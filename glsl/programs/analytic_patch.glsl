@@ -73,6 +73,11 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     float z0 = ro.z + t0 * rd.z;
     float z1 = ro.z + t1 * rd.z;
     for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
+    // Convex hull property: no sign change among the coefficients, no root on the segment (the common
+    // case for cells the hierarchy could not rule out); skip the root finder.
+    float cmin = min(min(min(c[0], c[1]), min(c[2], c[3])), c[4]);
+    float cmax = max(max(max(c[0], c[1]), max(c[2], c[3])), c[4]);
+    if (cmin > 0.0 || cmax < 0.0) return false;
     float s = sv_first_root(c, 4, sv_newton_iterations);
     if (s < 0.0) return false;
 

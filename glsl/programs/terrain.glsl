@@ -86,6 +86,11 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) 
     float z0 = o.z + t0 * d.z;
     float z1 = o.z + t1 * d.z;
     for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
+    // Convex hull property: no sign change among the coefficients, no root on the segment (the common
+    // case for cells the hierarchy could not rule out); skip the root finder.
+    float cmin = min(min(min(c[0], c[1]), min(c[2], c[3])), c[4]);
+    float cmax = max(max(max(c[0], c[1]), max(c[2], c[3])), c[4]);
+    if (cmin > 0.0 || cmax < 0.0) return SV_NO_HIT;
     float s = sv_first_root(c, 4, sv_newton_iterations);
     return s < 0.0 ? SV_NO_HIT : mix(t0, t1, s);
 }
