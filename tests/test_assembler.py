@@ -118,3 +118,14 @@ def test_sv_conditionals_are_resolved_at_assembly_other_conditionals_kept():
 def test_unclosed_sv_conditional_is_reported():
     with pytest.raises(ValueError, match="not closed"):
         assemble("#ifdef SV_A\nfloat x;\n", {})
+
+
+def test_generated_blossom_steps_are_current():
+    import importlib.util
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("gen_blossom_glsl", root / "tools" / "gen_blossom_glsl.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    assert (glsl_root() / "lib" / "blossom_steps.glsl").read_text() == gen.generate(), \
+        "run: python tools/gen_blossom_glsl.py"
