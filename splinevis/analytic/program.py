@@ -15,8 +15,10 @@ def patch_program(patch: QuarticTrianglePatch, *, newton_iterations: int = 6,
                   coefficients_in: str = "uniform") -> ProgramSpec:
     """Describe the ray-cast program of ``patch`` (proxy prism, coefficients and matrix as uniforms).
 
-    ``newton_iterations`` (1..8) is the fixed Newton step count of lib/roots.glsl (paper 000: 5 hide
-    visible artifacts, 6 reach full float precision). ``coefficients_in="texture"`` reads the
+    ``newton_iterations`` (1..8) is the fixed step count of ``sv_first_root`` in lib/roots.glsl: per
+    bracketed run of the default bracketed Newton on convex pieces (bracket <= 4^-N of a piece), or
+    the Newton steps of paper 000's method with the define ``SV_ROOTS_PAPER_NEWTON`` (5 hide visible
+    artifacts, 6 reach full float precision there). ``coefficients_in="texture"`` reads the
     coefficients from an RGBA32F table indexed by a per-vertex patch id instead of uniforms: the same
     image, through the plumbing large models need.
     """

@@ -159,11 +159,18 @@ def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, r
     if isinstance(outputs, bool) or not isinstance(outputs, (int, np.integer)) or not 1 <= outputs <= _MAX_OUTPUTS:
         raise ValueError(f"outputs must be an integer in 1..{_MAX_OUTPUTS}; got {outputs!r}.")
     x = np.ascontiguousarray(x, dtype=np.float32)
+    ctx = get_context()
+    # Make the harness context current for the whole pass and restore the caller's afterwards: another GL
+    # user in the process (a VTK render window) may have left its own context current, and then the
+    # driver refuses to create programs ("cannot create program").
+    with ctx:
+        return _run(ctx, x, functions, body, outputs, defines, root)
+
+
+def _run(ctx, x, functions, body, outputs, defines, root):
     m, k = x.shape
     n_tex = math.ceil(k / 4)
     n_att = math.ceil(outputs / 4)
-
-    ctx = get_context()
     max_size = int(ctx.info.get("GL_MAX_TEXTURE_SIZE", 8192))
     width = max(1, math.ceil(math.sqrt(m)))
     if width > max_size:

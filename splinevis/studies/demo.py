@@ -5,6 +5,8 @@
   ways round (the surface writes ``gl_FragDepth``).
 * ``effects.png`` -- the same patch under each effect set; every panel compiled only its own effects.
 * ``composite_check.png`` -- which surface is in front per pixel, GPU against the float64 reference.
+* ``terrain.png`` -- a synthetic DEM (UTM-sized origin) as a C1 quartic spline: colour by height with
+  reflection lines, beside the same data as a linear mesh and as the C2 box spline.
 """
 
 from __future__ import annotations
@@ -85,7 +87,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _effect_panels()
-    steps = tqdm(total=2 + len(panels), desc="showcase", disable=not progress, unit="fig")
+    steps = tqdm(total=3 + len(panels), desc="showcase", disable=not progress, unit="fig")
     written = {}
 
     pl, patch, _ = composite_scene()
@@ -97,10 +99,13 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     steps.update()
 
     result = front_surface_agreement(window_size=(640, 480))
+    from matplotlib.colors import ListedColormap
+
+    classes = ListedColormap(["white", "firebrick", "royalblue"])  # background, patch, sphere
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-    axes[0].imshow(result["gpu_front"], cmap="coolwarm", vmin=0, vmax=2, interpolation="nearest")
+    axes[0].imshow(result["gpu_front"], cmap=classes, vmin=0, vmax=2, interpolation="nearest")
     axes[0].set_title("GPU: front surface (red = patch, blue = sphere)")
-    axes[1].imshow(result["reference_front"], cmap="coolwarm", vmin=0, vmax=2, interpolation="nearest")
+    axes[1].imshow(result["reference_front"], cmap=classes, vmin=0, vmax=2, interpolation="nearest")
     axes[1].set_title("float64 reference")
     axes[2].imshow(result["disagree"], cmap="gray_r", interpolation="nearest")
     axes[2].set_title(f"disagreement: {result['disagree_count']} of {result['compared']} px "
@@ -133,5 +138,40 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     written["effects"] = path
+    path = out / "terrain.png"
+    _terrain_figure(path)
+    written["terrain"] = path
+    steps.update()
     steps.close()
     return written
+
+
+def _terrain_figure(path):
+    import matplotlib.pyplot as plt
+    from scipy.ndimage import gaussian_filter
+
+    from datasets_synthetic.dem_files import fractal_terrain
+    from ..io import read_heights
+    from ..plotting import Plotter
+
+    heights = 400.0 + 300.0 * gaussian_filter(fractal_terrain(65, seed=7, hurst=0.9), 1.5, mode="wrap")
+    grid = read_heights(heights, spacing=(60.0, 60.0), origin=(500_010.0, 5_100_020.0))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    for ax, scheme in zip(axes, ("linear", "C2", "C1")):
+        pl = Plotter(off_screen=True, window_size=(600, 440))
+        pl.set_background("white")
+        actor = pl.add_terrain(grid, scheme, colormap="terrain", lights=2, reflection_lines=30)
+        x0, x1, y0, y1 = actor.model.extent
+        zlo, zhi = actor.model.zrange
+        cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+        pl.camera_position = [(cx - 0.5 * (x1 - x0), cy - 1.1 * (y1 - y0), zhi + 0.9 * (x1 - x0)), (cx, cy, zlo),
+                              (0, 0, 1)]
+        pl.reset_camera_clipping_range()
+        ax.imshow(pl.screenshot())
+        pl.close()
+        ax.set_title(f"{scheme}: {actor.model.num_patches:,} patches, reflection lines", fontsize=10)
+        ax.set_axis_off()
+    fig.suptitle("65x65 DEM at UTM (500010, 5100020), every pixel ray-cast on the spline", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
