@@ -5,7 +5,8 @@
 //    (the convex-hull property bounds f there).
 // 2. Restrict f to the projected segment by blossoming (paper 000, eq. (6)-(7)): five univariate BB
 //    coefficients; subtract the ray's height, itself degree-elevated to a quartic.
-// 3. First root in [0,1] by Newton from secure starting points (lib/roots.glsl).
+// 3. First root in [0,1] (lib/roots.glsl sv_first_root): bracketed Newton on convex pieces, or paper
+//    000's Newton from secure starting points when SV_ROOTS_PAPER_NEWTON is defined.
 // 4. Value, gradient (and Hessian for curvature) by de Casteljau at the hit (lib/bb_triangle.glsl).
 #include "lib/raycast.glsl"
 #include "lib/bb_triangle.glsl"
