@@ -8,6 +8,8 @@ Cases
   surface with 10^3 .. 10^6 triangles, same camera, 800x600, anti-aliasing off.
 * ``effect_sets``: frame time of the ray-cast patch under each effect set (only the declared effects
   are compiled in, so the cost of an effect is the difference to the baseline).
+* ``terrain``: the terrain ray caster on 65x65 .. 1025x1025 grids in one full-screen view, with the
+  min/max hierarchy on and off (the hierarchical equivalent of the paper's front-to-back occlusion sets).
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -111,6 +113,36 @@ def bench_effect_sets(repeats, quick):
     return rows
 
 
+def bench_terrain(repeats, quick):
+    """Terrain ray casting: frame time vs grid size in one full-screen oblique view (the target is a
+    1024x1024 grid within 3x the time of a 64x64 grid), and the min/max hierarchy on vs off."""
+    from datasets_synthetic.dem_files import fractal_terrain
+    from splinevis.plotting import Plotter
+    from splinevis.terrain.model import TerrainSpline
+
+    sizes = [65, 257] + ([] if quick else [1025])
+    rows = []
+    for n in sizes:
+        z = fractal_terrain(n, seed=3) * 0.15
+        t = TerrainSpline.from_heights(z, "C2", spacing=(1.0 / (n - 1), 1.0 / (n - 1)))
+        for hierarchy in (True, False):
+            if not hierarchy and n > 257:
+                continue  # a cell-by-cell walk over 1024 cells per ray: minutes per frame
+            pl = Plotter(off_screen=True, window_size=WINDOW)
+            pl.add_spline(t, lights=1, program_options={"hierarchy": hierarchy})
+            pl.camera_position = [(0.5, -0.35, 0.55), (0.5, 0.45, 0.0), (0, 0, 1)]
+            pl.camera.clipping_range = (0.01, 10.0)
+            r = _time_frames(pl, repeats)
+            covered = float((pl.depth_buffer() < 1.0).mean())
+            pl.close()
+            rows.append({"grid": f"{n}x{n}", "patches": t.num_patches, "hierarchy": hierarchy,
+                         "screen_covered": covered, **r})
+    base = next(r["median_ms"] for r in rows if r["hierarchy"])
+    for r in rows:
+        r["ratio_to_smallest_grid"] = r["median_ms"] / base
+    return rows
+
+
 def _markdown(results):
     lines = [f"# splinevis benchmarks\n\n{results['machine']}\n"]
     lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
@@ -123,6 +155,12 @@ def _markdown(results):
     lines.append("|---|---|---:|---:|---:|")
     for r in results["effect_sets"]:
         lines.append(f"| {r['effect_set']} | {', '.join(r['effects']) or '-'} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_unlit']:.2f} |")
+    lines.append("\n## Terrain ray casting: grid size and hierarchy (same full-screen oblique view)\n")
+    lines.append("| grid | patches | hierarchy | screen covered | min ms | median ms | median / 65x65 |")
+    lines.append("|---|---:|---|---:|---:|---:|---:|")
+    for r in results["terrain"]:
+        lines.append(f"| {r['grid']} | {r['patches']:,} | {'min/max quadtree' if r['hierarchy'] else 'off (cell walk)'} | "
+                     f"{r['screen_covered']:.2f} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_smallest_grid']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -139,7 +177,8 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
-    for name, fn in tqdm([("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets)], desc="benchmarks"):
+    cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain)]
+    for name, fn in tqdm(cases, desc="benchmarks"):
         results[name] = fn(args.repeats, args.quick)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
