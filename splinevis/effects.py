@@ -162,7 +162,13 @@ class Style:
 
     # -- code -----------------------------------------------------------------------------------------
     def effect_set(self) -> frozenset:
-        """The names of the declared effects: what decides the compiled code."""
+        """The names of the declared effects: what decides the compiled code.
+
+        An output mode (normals, curvature, depth) replaces shading, so lights, colours and overlays
+        are not compiled in with it.
+        """
+        if self.output is not None:
+            return frozenset({self.output})
         on = set()
         if self.lights:
             on.add("lights")
@@ -200,7 +206,8 @@ class Style:
         return d / np.linalg.norm(d, axis=1, keepdims=True)
 
     def uniforms(self) -> dict:
-        """Scalar and vector uniforms (name -> float or tuple); set without recompiling."""
+        """Scalar and vector uniforms (name -> float or tuple); set without recompiling (uniforms of
+        effects that are not compiled in are simply not found by the driver and ignored)."""
         u = {"sv_color": self.color, "sv_ambient": float(self.ambient), "sv_diffuse": float(self.diffuse)}
         if self.specular:
             u["sv_specular_power"] = float(self.specular_power)

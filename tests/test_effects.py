@@ -54,3 +54,9 @@ def test_bad_style_input_is_named(kwargs, match):
 def test_replace_rejects_unknown_fields():
     with pytest.raises(TypeError, match=r"no field\(s\) \['reflection'\]"):
         Style().replace(reflection=3)
+
+
+def test_output_modes_compile_nothing_else():
+    s = Style(lights=3, specular=True, reflection_lines=5, output="normals")
+    assert s.effect_set() == {"normals"}
+    assert s.include_files() == ["lib/effects/normals.glsl"]

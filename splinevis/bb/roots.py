@@ -428,6 +428,51 @@ def _to_power(c):
     return c @ mat.T
 
 
+def _isolated_roots(flat: np.ndarray) -> np.ndarray:
+    """Roots in [0, 1] by recursive isolation: the roots of f' split [0, 1] into pieces where f is
+    monotone, so each piece holds at most one root, found by 60 float64 bisections where f changes
+    sign; a critical point where |f| is at rounding level is a multiple root. Exact by construction up to
+    float64 rounding, whatever the root spacing (a candidate source for :func:`roots_reference`).
+    flat: (m, n + 1). Returns (m, n) sorted, NaN padded (n >= 1)."""
+    m, n1 = flat.shape
+    n = n1 - 1
+    out = np.full((m, max(n, 1)), np.nan)
+    if n == 0:
+        return out
+    if n == 1:
+        with np.errstate(all="ignore"):
+            t = flat[:, 0] / (flat[:, 0] - flat[:, 1])
+        out[:, 0] = np.where((t >= 0.0) & (t <= 1.0), t, np.nan)
+        return out
+    crit = _isolated_roots(n * (flat[:, 1:] - flat[:, :-1]))  # (m, n - 1)
+    brk = np.sort(np.concatenate([np.zeros((m, 1)), crit, np.ones((m, 1))], axis=1), axis=1)  # NaN last
+    a, b = brk[:, :-1], brk[:, 1:]
+    valid = np.isfinite(a) & np.isfinite(b) & (b > a)
+    a0, b0 = np.where(valid, a, 0.0), np.where(valid, b, 0.0)
+    c3 = flat[:, None, :]
+    fa, _ = _eval_deriv(c3, a0, np.float64)
+    fb, _ = _eval_deriv(c3, b0, np.float64)
+    S, _ = _eval_deriv(np.abs(c3), a0, np.float64)
+    tol = 8 * n * np.finfo(np.float64).eps * S
+    found = np.full(a.shape, np.nan)
+    found = np.where(valid & (np.abs(fa) <= tol), a0, found)  # root (possibly multiple) at the piece start
+    change = valid & np.isnan(found) & (np.signbit(fa) != np.signbit(fb)) & (fb != 0.0)
+    lo, hi, flo = a0.copy(), b0.copy(), fa.copy()
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        fm, _ = _eval_deriv(c3, mid, np.float64)
+        same = np.signbit(fm) == np.signbit(flo)
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+    found = np.where(change, 0.5 * (lo + hi), found)
+    f1, _ = _eval_deriv(c3, np.ones((m, 1)), np.float64)
+    S1, _ = _eval_deriv(np.abs(c3), np.ones((m, 1)), np.float64)
+    end = np.where(np.abs(f1[:, 0]) <= 8 * n * np.finfo(np.float64).eps * S1[:, 0], 1.0, np.nan)
+    x = np.sort(np.concatenate([found, end[:, None]], axis=1), axis=1)
+    x[:, 1:] = np.where(x[:, 1:] - x[:, :-1] <= 1e-14, np.nan, x[:, 1:])
+    return np.sort(x, axis=1)[:, : max(n, 1)]
+
+
 def roots_reference(c) -> np.ndarray:
     """Every root in [0, 1] of univariate BB polynomials, in float64.
 
@@ -447,7 +492,9 @@ def roots_reference(c) -> np.ndarray:
     Candidates come from (a) the eigenvalues of the companion matrix of the power form whose imaginary
     part is below 1e-5 (a double root splits into a pair ~1e-8 off the real axis) and (b) a scan of
     signs on a 64-interval grid refined by 52 bisection steps (catches roots the eigenvalues misplace),
-    plus exact zeros at the grid points. Eigenvalue candidates are polished by 20 float64 Newton steps
+    plus exact zeros at the grid points, and (c) recursive isolation: the roots of f' (found the same way)
+    cut [0, 1] into monotone pieces, each bisected where f changes sign, critical points with |f| at
+    rounding level being multiple roots. Eigenvalue candidates are polished by 20 float64 Newton steps
     (a step is taken only if it lowers ``|f|``) and kept if ``|f(x)| <= 16 n eps64 sum |c_k| B_k(x)``;
     candidates closer than 1e-7 are merged.
     """
@@ -517,8 +564,10 @@ def roots_reference(c) -> np.ndarray:
         f, _ = _eval_deriv(c3, xe, np.float64)
         S, _ = _eval_deriv(np.abs(c3), xe, np.float64)
         xe = np.where(np.abs(f) <= 16 * n * np.finfo(np.float64).eps * S, xe, np.nan)
+        # (c) recursive isolation on monotone pieces (catches close pairs and multiple roots)
+        iso = _isolated_roots(flat)
         # grid zeros are exact roots, bisection brackets are roots by the sign change
-        x = np.concatenate([xe, cands[2], bis], axis=1)
+        x = np.concatenate([xe, cands[2], bis, iso], axis=1)
         x = np.where(~zero[:, None], x, np.nan)
         x = np.sort(x, axis=1)
         dup = np.zeros_like(x, dtype=bool)

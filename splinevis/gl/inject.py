@@ -311,7 +311,7 @@ class SplineActor:
             u["sv_eye_mc"] = eye
             u["sv_view_dir_mc"] = view
             u["sv_parallel"] = int(parallel)
-            if self.style.lights:
+            if "lights" in self.style.effect_set():
                 dirs = self.style.light_directions_camera() @ world_from_cam.T
                 u["sv_light_dir[]"] = dirs
             if self.spec.frame_uniforms is not None:
