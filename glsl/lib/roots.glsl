@@ -145,8 +145,10 @@ float sv_first_root_newton4(float c[5], int n, int iterations) {
 // [lo, hi]: always inside the final bracket.
 float sv_bracket_newton(float g[5], int m, float lo, float hi, float glo, float ghi, float dlo, float dhi,
                         float sigma, int iterations) {
-    for (int it = 0; it < SV_ROOT_MAX_ITERATIONS; ++it) {
-        if (it < iterations) {
+    // A uniform loop bound (iterations is the same for every fragment): ~10% faster on llvmpipe than a
+    // constant bound with a masked body. Callers keep iterations in 1..SV_ROOT_MAX_ITERATIONS.
+    for (int it = 0; it < iterations; ++it) {
+        {
             bool from_lo = (sigma != 0.0) ? ((glo < 0.0) == (sigma < 0.0)) : (abs(glo) <= abs(ghi));
             float x = from_lo ? lo : hi;
             float gx = from_lo ? glo : ghi;
