@@ -304,7 +304,7 @@ def scaling(repeats=5, sizes=(65, 1025)):
 
 def comparison_figure(path, *, n=13, fine_factor=5):
     """Normals, shading and reflection lines for linear vs C0/C1/C2 at n x n data, and linear at
-    (fine_factor (n-1) + 1)^2 data (25x the data for fine_factor 5) -- paper Figs. 14-16."""
+    (fine_factor (n-1) + 1)^2 data (fine_factor 5: 25x the cells, about 22x the samples) -- paper Figs. 14-16."""
     import matplotlib
 
     matplotlib.use("Agg")
