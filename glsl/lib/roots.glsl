@@ -213,7 +213,19 @@ float sv_first_root_bracketed(float c[5], int n, int iterations) {
     sv_bernstein_eval_deriv4(ca, n, p, S, fp);
     sv_bernstein_eval_deriv4(d, n - 1, p, g, gp);  // g = f', gp = f'' at the secure points
     vec4 tol = sv_root_tol_k(n) * SV_ROOT_EPS32 * S;
+    // The pieces are scanned left to right; the first that brackets a root is refined by ONE call of
+    // sv_bracket_newton after the scan (a single inlined copy: on SIMD rasterizers every copy costs all
+    // lanes). Same decisions and arithmetic as before, so the float32 twin is unchanged.
+    bool have = false;
+    float A = 0.0;
+    float B = 0.0;
+    float FA = 0.0;
+    float FB = 0.0;
+    float DA = 0.0;
+    float DB = 0.0;
+    float SIG = 0.0;
     for (int i = 0; i < 3; ++i) {
+        if (have) break;
         float a = p[i];
         float b = p[i + 1];
         float fa = f[i];
@@ -222,21 +234,29 @@ float sv_first_root_bracketed(float c[5], int n, int iterations) {
         float sigma = g[i + 1] - g[i];  // has the sign of f'' on the piece
         bool change = (fb == 0.0) ? (g[i + 1] != 0.0 && ((fa < 0.0) == (g[i + 1] < 0.0)))
                                   : ((fa < 0.0) != (fb < 0.0));
-        if (change) return sv_bracket_newton(c, n, a, b, fa, fb, g[i], g[i + 1], sigma, iterations);
-        bool dip = g[i] != 0.0 && g[i + 1] != 0.0 && ((fa < 0.0) != (g[i] < 0.0))
-                   && ((g[i] < 0.0) != (g[i + 1] < 0.0));
-        if (dip) {
-            float m = sv_bracket_newton(d, n - 1, a, b, g[i], g[i + 1], gp[i], gp[i + 1], 0.0, iterations);
-            float fm;
-            float fpm;
-            float Sm;
-            float dummy;
-            sv_bernstein_eval_deriv(c, n, m, fm, fpm);
-            sv_bernstein_eval_deriv(ca, n, m, Sm, dummy);
-            if (abs(fm) <= sv_root_tol_k(n) * SV_ROOT_EPS32 * Sm) return m;
-            if ((fm < 0.0) != (fa < 0.0)) return sv_bracket_newton(c, n, a, m, fa, fm, g[i], fpm, sigma, iterations);
+        if (change) {
+            have = true;
+            A = a; B = b; FA = fa; FB = fb; DA = g[i]; DB = g[i + 1]; SIG = sigma;
+        } else {
+            bool dip = g[i] != 0.0 && g[i + 1] != 0.0 && ((fa < 0.0) != (g[i] < 0.0))
+                       && ((g[i] < 0.0) != (g[i + 1] < 0.0));
+            if (dip) {
+                float m = sv_bracket_newton(d, n - 1, a, b, g[i], g[i + 1], gp[i], gp[i + 1], 0.0, iterations);
+                float fm;
+                float fpm;
+                float Sm;
+                float dummy;
+                sv_bernstein_eval_deriv(c, n, m, fm, fpm);
+                sv_bernstein_eval_deriv(ca, n, m, Sm, dummy);
+                if (abs(fm) <= sv_root_tol_k(n) * SV_ROOT_EPS32 * Sm) return m;
+                if ((fm < 0.0) != (fa < 0.0)) {
+                    have = true;
+                    A = a; B = m; FA = fa; FB = fm; DA = g[i]; DB = fpm; SIG = sigma;
+                }
+            }
         }
     }
+    if (have) return sv_bracket_newton(c, n, A, B, FA, FB, DA, DB, SIG, iterations);
     return (abs(f[3]) <= tol[3]) ? 1.0 : -1.0;
 }
 
