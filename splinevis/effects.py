@@ -89,7 +89,11 @@ class Style:
     scalar_range : (float, float), optional
         Scalar values mapped to the ends of the colormap; defaults to the model's range.
     texture : (H, W, 3|4) uint8 ndarray, optional
-        Image draped over the surface's parameter domain (u, v in [0, 1]).
+        Image draped over the surface's parameter domain (u, v in [0, 1]; for a terrain, its grid
+        extent), row 0 at the top (north).
+    texture_extent : (xmin, xmax, ymin, ymax), optional
+        Geo-reference of ``texture`` in the model's coordinates (e.g. the image's own UTM extent); the
+        surface outside it keeps its base colour. Default: the image covers the model's extent.
     environment : (H, W, 3) uint8 ndarray, optional
         Latitude-longitude environment image, reflected by the surface.
     reflection_lines : int, optional
@@ -119,6 +123,7 @@ class Style:
     colormap: str | None = None
     scalar_range: tuple | None = None
     texture: Any = field(default=None, compare=False, hash=False)
+    texture_extent: tuple | None = None
     environment: Any = field(default=None, compare=False, hash=False)
     reflection_lines: int | None = None
     isophotes: int | None = None
@@ -145,6 +150,12 @@ class Style:
             lo, hi = as_float64_array(self.scalar_range, "Style.scalar_range", ndim=1, shape_tail=(2,))
             if not hi > lo:
                 raise ValueError(f"Style.scalar_range must be (low, high) with low < high, got {self.scalar_range!r}.")
+        if self.texture_extent is not None:
+            if self.texture is None:
+                raise ValueError("Style.texture_extent needs a texture to geo-reference.")
+            ext = as_float64_array(self.texture_extent, "Style.texture_extent", ndim=1, shape_tail=(4,))
+            if not (ext[1] > ext[0] and ext[3] > ext[2]):
+                raise ValueError(f"Style.texture_extent must be (xmin, xmax, ymin, ymax) with min < max, got {tuple(ext)}.")
         for name in ("texture", "environment"):
             img = getattr(self, name)
             if img is not None:

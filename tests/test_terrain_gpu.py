@@ -96,3 +96,42 @@ def test_hierarchy_full_truncated_and_off_give_identical_images(franke_c2c):
     assert (images[0].sum(-1) < 700).mean() > 0.1
     # Skipping blocks must never change what a pixel shows: same hits, same shading.
     assert all(np.array_equal(images[0], im) for im in images[1:])
+
+
+def test_texture_is_geo_referenced_by_its_extent():
+    import splinevis
+
+    z = np.zeros((33, 33))
+    z[16, 16] = 1e-3  # not exactly flat
+    t = TerrainSpline.from_heights(z, "C2", spacing=(10.0, 10.0), origin=(500_000.0, 5_100_000.0))
+    x0, x1, y0, y1 = t.extent
+    img = np.zeros((8, 8, 3), np.uint8)
+    img[:, :4] = (255, 0, 0)   # west half of the image red
+    img[:, 4:] = (0, 0, 255)   # east half blue
+    xm = 0.5 * (x0 + x1)
+    pl = splinevis.Plotter(off_screen=True, window_size=(320, 320))
+    pl.set_background("white")
+    # the image covers only the western half of the terrain
+    pl.add_spline(t, lights=0, color=(0.0, 1.0, 0.0), texture=img, texture_extent=(x0, xm, y0, y1))
+    cx, cy = xm, 0.5 * (y0 + y1)
+    pl.camera_position = [(cx, cy, 2000.0), (cx, cy, 0.0), (0, 1, 0)]
+    pl.enable_parallel_projection()
+    pl.camera.parallel_scale = 0.5 * (y1 - y0)
+    pl.reset_camera_clipping_range()
+    im = pl.screenshot().astype(int)
+    pl.close()
+    row = im[160]
+    def colour(col):
+        r, g, b = row[col]
+        return "red" if r > 200 and g < 60 else "blue" if b > 200 and r < 60 else "green" if g > 200 and r < 60 else "?"
+    # screen x spans the terrain's x extent: quarters 1, 2 from the image, the east half base colour
+    assert [colour(c) for c in (40, 120, 200, 280)] == ["red", "blue", "green", "green"]
+
+
+@pytest.mark.parametrize("heights", ["flat", "almost flat"])
+def test_flat_terrain_renders_without_holes(heights):
+    z = np.full((17, 17), 250.0)
+    if heights == "almost flat":
+        z[8, 8] += 1e-4
+    t = TerrainSpline.from_heights(z, "C1", spacing=(1.0, 1.0))
+    _check(depth_agreement(t, [(-6.0, -9.0, 262.0), (8.0, 8.0, 250.0), (0, 0, 1)]))

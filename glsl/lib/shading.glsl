@@ -17,7 +17,7 @@ vec4 sv_shade(SvHit h, vec3 rd) {
     base = sv_colormap(h.scalar);
 #endif
 #ifdef SV_TEXTURE
-    base = sv_texture_color(h.uv);
+    base = sv_texture_color(h.uv, base);
 #endif
     vec3 col = base;
 #ifdef SV_NUM_LIGHTS

@@ -57,11 +57,15 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             if (lam_d[i] > 0.0) t0 = max(t0, tc); else t1 = min(t1, tc);
         }
     }
+    // Slab widened by ~16 ulps of the heights involved (a flat patch must not collapse it to a point).
+    float zpad = 1.0e-6 * (max(abs(sv_patch_zrange.x), abs(sv_patch_zrange.y)) + abs(ro.z)) + 1.0e-30;
+    float zlo = sv_patch_zrange.x - zpad;
+    float zhi = sv_patch_zrange.y + zpad;
     if (abs(rd.z) < 1e-30) {
-        if (ro.z < sv_patch_zrange.x || ro.z > sv_patch_zrange.y) return false;
+        if (ro.z < zlo || ro.z > zhi) return false;
     } else {
-        float ta = (sv_patch_zrange.x - ro.z) / rd.z;
-        float tb = (sv_patch_zrange.y - ro.z) / rd.z;
+        float ta = (zlo - ro.z) / rd.z;
+        float tb = (zhi - ro.z) / rd.z;
         t0 = max(t0, min(ta, tb));
         t1 = min(t1, max(ta, tb));
     }

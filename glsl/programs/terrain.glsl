@@ -72,6 +72,11 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) 
     float zlo = b[0];
     float zhi = b[0];
     for (int q = 1; q < 15; ++q) { zlo = min(zlo, b[q]); zhi = max(zhi, b[q]); }
+    // Widen the slab by ~16 ulps of the heights involved: over a flat (or nearly flat) triangle the
+    // slab would otherwise collapse to a point and float32 rounding alone would decide hit or miss.
+    float zpad = 1.0e-6 * (max(abs(zlo), abs(zhi)) + abs(o.z)) + 1.0e-30;
+    zlo -= zpad;
+    zhi += zpad;
     if (abs(d.z) < 1e-30) {
         if (o.z < zlo || o.z > zhi) return SV_NO_HIT;
     } else {

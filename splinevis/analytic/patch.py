@@ -207,6 +207,9 @@ class QuarticTrianglePatch:
                 t0 = np.where(~flat & (lam_d[..., i] > 0), np.maximum(t0, tc), t0)
                 t1 = np.where(~flat & (lam_d[..., i] < 0), np.minimum(t1, tc), t1)
             zlo, zhi = self.zrange
+            # slab widened by ~4500 ulps of the heights involved (a flat patch must not collapse it)
+            zpad = 1e-12 * (max(abs(zlo), abs(zhi)) + np.abs(o[..., 2])) + 1e-300
+            zlo, zhi = zlo - zpad, zhi + zpad
             flat = np.abs(d[..., 2]) < 1e-30
             miss |= flat & ((o[..., 2] < zlo) | (o[..., 2] > zhi))
             ta = (zlo - o[..., 2]) / d[..., 2]

@@ -303,6 +303,17 @@ class SplineActor:
         rot = np.array([[m.GetElement(i, j) for j in range(3)] for i in range(3)])  # camera-from-world
         return eye, view, bool(cam.GetParallelProjection()), rot.T
 
+    def _texture_map(self):
+        """(scale_u, scale_v, shift_u, shift_v) from the model's parameter domain to the image."""
+        ext = self.style.texture_extent
+        model_ext = getattr(self.model, "extent", None)
+        if ext is None or model_ext is None or not isinstance(model_ext, tuple):
+            return (1.0, 1.0, 0.0, 0.0)
+        mx0, mx1, my0, my1 = model_ext
+        ex0, ex1, ey0, ey1 = (float(v) for v in ext)
+        su, sv = (mx1 - mx0) / (ex1 - ex0), (my1 - my0) / (ey1 - ey0)
+        return (su, sv, (mx0 - ex0) / (ex1 - ex0), (my0 - ey0) / (ey1 - ey0))
+
     def frame_uniforms(self) -> dict:
         """All uniforms for the next frame: camera, lights, spec, style and extras."""
         u = {}
@@ -318,6 +329,8 @@ class SplineActor:
                 u.update(self.spec.frame_uniforms(eye, view))
         u.update(self.spec.uniforms)
         u.update(self.style.uniforms())
+        if self.style.texture is not None:
+            u["sv_texture_map"] = self._texture_map()
         u.update(self.extra_uniforms)
         return u
 

@@ -52,6 +52,10 @@ def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="re
         t0, t1, lam_o, lam_d = _clip_triangle(lu0, lv0, du, dv, ta, tb, tri)
         c = coef_cell[:, tri]
         zlo, zhi = c.min(axis=-1), c.max(axis=-1)
+        # widen the slab by ~4500 ulps of the heights involved: a flat triangle would collapse it to a point
+        # and leave hit or miss to rounding (the shader does the same at float32 scale)
+        zpad = 1e-12 * (np.maximum(np.abs(zlo), np.abs(zhi)) + np.abs(z0)) + 1e-300
+        zlo, zhi = zlo - zpad, zhi + zpad
         with np.errstate(divide="ignore", invalid="ignore"):
             flat = np.abs(dz) < 1e-300
             tza = (zlo - z0) / dz
@@ -116,6 +120,8 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     Z0 = o[:, 2] - terrain.z_ref
     dU, dV, dZ = d[:, 0] / sx, d[:, 1] / sy, d[:, 2]
     zlo, zhi = float(terrain.coefficients.min()), float(terrain.coefficients.max())
+    zpad = 1e-12 * max(abs(zlo), abs(zhi), 1.0)
+    zlo, zhi = zlo - zpad, zhi + zpad
     t0 = np.full(n, float(tmin))
     t1 = np.full(n, np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
