@@ -21,9 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -32,14 +30,9 @@ WINDOW = (800, 600)
 
 
 def _time_frames(pl, repeats):
-    pl.render_now()  # warm-up: compiles the program, uploads buffers
-    pl.render_now()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        pl.render_now()
-        times.append(time.perf_counter() - t0)
-    return {"min_ms": 1e3 * min(times), "median_ms": 1e3 * statistics.median(times), "repeats": repeats}
+    from splinevis.analysis.timing import frame_times
+
+    return frame_times(pl, repeats)
 
 
 def _scene(style=None, mesh=None):

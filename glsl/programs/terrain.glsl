@@ -10,8 +10,7 @@
 // the patch count. The float64 reference is splinevis.terrain.raycast (a plain cell-by-cell DDA).
 #include "lib/raycast.glsl"
 #include "lib/bb_triangle.glsl"
-#include "lib/blossom.glsl"
-#include "lib/roots.glsl"
+#include "lib/graph_patch.glsl"
 
 // VTK declares the samplers of the textures set on the actor: sv_terrain_coef (RGBA32F, 8 texels per
 // cell: T0's 15 then T1's 15 coefficients, row = cell j, texel 8 i + q) and sv_terrain_minmax
@@ -48,56 +47,18 @@ vec3 sv_cell_bary(vec2 p, int tri) {
     return tri == 0 ? vec3(1.0 - p.x, p.x - p.y, p.y) : vec3(1.0 - p.y, p.x, p.y - p.x);
 }
 
-// First hit of the cell-local ray (o + t d) with triangle `tri` for t in [ta, tb]; 3e38 if none
-// (t may be negative: rays start on the far side of the proxy, see lib/raycast.glsl).
-const float SV_NO_HIT = 3.0e38;
 // Cells and triangles are clipped with a margin of 2^-16 of a cell (about 8 ulps of cell-local
 // coordinates of size ~30): a root on a shared edge, which float32 rounding could push out of both
 // neighbours' segments (a crack), is then found by at least one of them. Inside the margin the
 // triangle's polynomial is its own extension, which meets the neighbour continuously (C0 at least).
 const float SV_CELL_MARGIN = 1.52587890625e-05;
+
+// First hit (t in [ta, tb]) of the cell-local ray o + t d with triangle `tri`; SV_NO_HIT if none
+// (t may be negative: rays start on the far side of the proxy, see lib/raycast.glsl).
 float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
     vec3 lo = sv_cell_bary(o.xy, tri);
     vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
-    float t0 = ta;
-    float t1 = tb;
-    for (int k = 0; k < 3; ++k) {
-        if (abs(ld[k]) < 1e-30) {
-            if (lo[k] < -SV_CELL_MARGIN) return SV_NO_HIT;
-        } else {
-            float tc = (-SV_CELL_MARGIN - lo[k]) / ld[k];
-            if (ld[k] > 0.0) t0 = max(t0, tc); else t1 = min(t1, tc);
-        }
-    }
-    float zlo = b[0];
-    float zhi = b[0];
-    for (int q = 1; q < 15; ++q) { zlo = min(zlo, b[q]); zhi = max(zhi, b[q]); }
-    // Widen the slab by ~16 ulps of the heights involved: over a flat (or nearly flat) triangle the
-    // slab would otherwise collapse to a point and float32 rounding alone would decide hit or miss.
-    float zpad = 1.0e-6 * (max(abs(zlo), abs(zhi)) + abs(o.z)) + 1.0e-30;
-    zlo -= zpad;
-    zhi += zpad;
-    if (abs(d.z) < 1e-30) {
-        if (o.z < zlo || o.z > zhi) return SV_NO_HIT;
-    } else {
-        float za = (zlo - o.z) / d.z;
-        float zb = (zhi - o.z) / d.z;
-        t0 = max(t0, min(za, zb));
-        t1 = min(t1, max(za, zb));
-    }
-    if (!(t0 <= t1)) return SV_NO_HIT;
-    float c[5];
-    sv_restrict_quartic_tri(b, lo + t0 * ld, lo + t1 * ld, c);
-    float z0 = o.z + t0 * d.z;
-    float z1 = o.z + t1 * d.z;
-    for (int k = 0; k < 5; ++k) c[k] -= mix(z0, z1, float(k) / 4.0);
-    // Convex hull property: no sign change among the coefficients, no root on the segment (the common
-    // case for cells the hierarchy could not rule out); skip the root finder.
-    float cmin = min(min(min(c[0], c[1]), min(c[2], c[3])), c[4]);
-    float cmax = max(max(max(c[0], c[1]), max(c[2], c[3])), c[4]);
-    if (cmin > 0.0 || cmax < 0.0) return SV_NO_HIT;
-    float s = sv_first_root(c, 4, sv_newton_iterations);
-    return s < 0.0 ? SV_NO_HIT : mix(t0, t1, s);
+    return sv_graph_patch_hit(b, lo, ld, o.z, d.z, ta, tb, SV_CELL_MARGIN, sv_newton_iterations);
 }
 
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {

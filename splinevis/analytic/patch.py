@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._validation import as_float64_array, check_choice
-from ..bb import roots as _roots
 from ..bb import simplex as _simplex
+from ..bb.ray import graph_patch_first_hit
 
 __all__ = ["QuarticTrianglePatch", "RayHits"]
 
@@ -196,44 +196,11 @@ class QuarticTrianglePatch:
         m = self._m
         lam_o = o[..., :2] @ m[:, :2].T + m[:, 2]
         lam_d = d[..., :2] @ m[:, :2].T
-        t0 = tmin.copy()
-        t1 = np.full(o.shape[:-1], np.inf)
-        miss = np.zeros(o.shape[:-1], dtype=bool)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            for i in range(3):
-                flat = np.abs(lam_d[..., i]) < 1e-30
-                miss |= flat & (lam_o[..., i] < 0)
-                tc = -lam_o[..., i] / lam_d[..., i]
-                t0 = np.where(~flat & (lam_d[..., i] > 0), np.maximum(t0, tc), t0)
-                t1 = np.where(~flat & (lam_d[..., i] < 0), np.minimum(t1, tc), t1)
-            zlo, zhi = self.zrange
-            # slab widened by ~4500 ulps of the heights involved (a flat patch must not collapse it)
-            zpad = 1e-12 * (max(abs(zlo), abs(zhi)) + np.abs(o[..., 2])) + 1e-300
-            zlo, zhi = zlo - zpad, zhi + zpad
-            flat = np.abs(d[..., 2]) < 1e-30
-            miss |= flat & ((o[..., 2] < zlo) | (o[..., 2] > zhi))
-            ta = (zlo - o[..., 2]) / d[..., 2]
-            tb = (zhi - o[..., 2]) / d[..., 2]
-            t0 = np.where(flat, t0, np.maximum(t0, np.minimum(ta, tb)))
-            t1 = np.where(flat, t1, np.minimum(t1, np.maximum(ta, tb)))
-        miss |= ~(t0 <= t1)
-        t0 = np.where(miss, 0.0, t0)
-        t1 = np.where(miss, 0.0, t1)
-        l0 = lam_o + t0[..., None] * lam_d
-        l1 = lam_o + t1[..., None] * lam_d
-        c = _simplex.restrict_to_segment(self._c, l0, l1, d=2)
-        z0 = o[..., 2] + t0 * d[..., 2]
-        z1 = o[..., 2] + t1 * d[..., 2]
-        k = np.arange(DEGREE + 1) / DEGREE
-        c = c - (z0[..., None] * (1 - k) + z1[..., None] * k)
-        if method == "gpu":
-            s = _roots.first_root_bracketed(c, iterations=iterations)
-        elif method == "paper":
-            s = _roots.newton_secure(c, iterations=iterations)
-        else:
-            s = _roots.first_root_reference(c)
-        s = np.where(miss, np.nan, s)
-        t = t0 + s * (t1 - t0)
+        shape = o.shape[:-1]
+        t = graph_patch_first_hit(
+            np.broadcast_to(self._c, shape + (15,)).reshape(-1, 15), lam_o.reshape(-1, 3), lam_d.reshape(-1, 3),
+            o[..., 2].ravel(), d[..., 2].ravel(), tmin.ravel(), np.full(tmin.size, np.inf),
+            method=method, iterations=iterations).reshape(shape)
         pts = o + t[..., None] * d
         hit = np.isfinite(t)
         normals = np.full(pts.shape, np.nan)

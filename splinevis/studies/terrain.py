@@ -161,14 +161,10 @@ def mesh_normal_error(n, o, d):
 
 
 def _frame_times(pl, repeats):
-    pl.render_now()
-    pl.render_now()
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        pl.render_now()
-        ts.append(time.perf_counter() - t0)
-    return 1e3 * min(ts), 1e3 * float(np.median(ts))
+    from ..analysis.timing import frame_times
+
+    r = frame_times(pl, repeats)
+    return r["min_ms"], r["median_ms"]
 
 
 def _scene_spline(terrain, iterations, style=None):

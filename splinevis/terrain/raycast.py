@@ -16,30 +16,10 @@ import numpy as np
 
 from .._validation import as_float64_array, check_choice
 from ..analytic.patch import RayHits
-from ..bb import roots as _roots
-from ..bb import simplex as _simplex
+from ..bb.ray import graph_patch_first_hit
 from .model import TerrainSpline, cell_barycentric
 
 __all__ = ["raycast_terrain", "first_hit_in_cell"]
-
-_K = np.arange(5) / 4.0
-
-
-def _clip_triangle(lu0, lv0, du, dv, ta, tb, tri):
-    """Clip the segment t in [ta, tb] of the cell-local line (lu0 + t du, lv0 + t dv) to triangle tri."""
-    lam_o = cell_barycentric(lu0, lv0, tri)
-    # direction: barycentric coordinates are affine, so the direction is lam(d) - lam(0)
-    lam_d = cell_barycentric(du, dv, tri) - cell_barycentric(np.zeros_like(du), np.zeros_like(dv), tri)
-    t0, t1 = ta.copy(), tb.copy()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for k in range(3):
-            flat = np.abs(lam_d[..., k]) < 1e-300
-            out = flat & (lam_o[..., k] < 0)
-            tc = -lam_o[..., k] / lam_d[..., k]
-            t0 = np.where(~flat & (lam_d[..., k] > 0), np.maximum(t0, tc), t0)
-            t1 = np.where(~flat & (lam_d[..., k] < 0), np.minimum(t1, tc), t1)
-            t1 = np.where(out, -np.inf, t1)
-    return t0, t1, lam_o, lam_d
 
 
 def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="reference", iterations=8):
@@ -48,38 +28,12 @@ def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="re
     The ray is given in cell-local coordinates: (lu0 + t du, lv0 + t dv) and height z0 + t dz.
     """
     best = np.full(ta.shape, np.nan)
+    zero = np.zeros_like(du)
     for tri in (0, 1):
-        t0, t1, lam_o, lam_d = _clip_triangle(lu0, lv0, du, dv, ta, tb, tri)
-        c = coef_cell[:, tri]
-        zlo, zhi = c.min(axis=-1), c.max(axis=-1)
-        # widen the slab by ~4500 ulps of the heights involved: a flat triangle would collapse it to a point
-        # and leave hit or miss to rounding (the shader does the same at float32 scale)
-        zpad = 1e-12 * (np.maximum(np.abs(zlo), np.abs(zhi)) + np.abs(z0)) + 1e-300
-        zlo, zhi = zlo - zpad, zhi + zpad
-        with np.errstate(divide="ignore", invalid="ignore"):
-            flat = np.abs(dz) < 1e-300
-            tza = (zlo - z0) / dz
-            tzb = (zhi - z0) / dz
-            t0 = np.where(flat, t0, np.maximum(t0, np.minimum(tza, tzb)))
-            t1 = np.where(flat, np.where((z0 < zlo) | (z0 > zhi), -np.inf, t1), np.minimum(t1, np.maximum(tza, tzb)))
-        ok = t0 <= t1
-        if not ok.any():
-            continue
-        idx = np.nonzero(ok)[0]
-        a, b = t0[idx], t1[idx]
-        l0 = lam_o[idx] + a[:, None] * lam_d[idx]
-        l1 = lam_o[idx] + b[:, None] * lam_d[idx]
-        cc = _simplex.restrict_to_segment(c[idx], l0, l1, d=2)
-        za = z0[idx] + a * dz[idx]
-        zb = z0[idx] + b * dz[idx]
-        cc = cc - (za[:, None] * (1 - _K) + zb[:, None] * _K)
-        if method == "reference":
-            s = _roots.first_root_reference(cc)
-        else:
-            s = _roots.first_root_bracketed(cc, iterations=iterations)
-        t = a + s * (b - a)
-        cur = best[idx]
-        best[idx] = np.where(np.isnan(cur) | (t < cur), t, cur)
+        lam_o = cell_barycentric(lu0, lv0, tri)
+        lam_d = cell_barycentric(du, dv, tri) - cell_barycentric(zero, zero, tri)
+        t = graph_patch_first_hit(coef_cell[:, tri], lam_o, lam_d, z0, dz, ta, tb, method=method, iterations=iterations)
+        best = np.where(np.isnan(best) | (t < best), t, best)
     return best
 
 
