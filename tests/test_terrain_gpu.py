@@ -135,3 +135,19 @@ def test_flat_terrain_renders_without_holes(heights):
         z[8, 8] += 1e-4
     t = TerrainSpline.from_heights(z, "C1", spacing=(1.0, 1.0))
     _check(depth_agreement(t, [(-6.0, -9.0, 262.0), (8.0, 8.0, 250.0), (0, 0, 1)]))
+
+
+def test_paper_root_finder_is_selectable_and_compiled_in_only_on_request(franke_c2c):
+    import splinevis
+
+    sources = {}
+    for roots in ("bracketed", "paper"):
+        pl = splinevis.Plotter(off_screen=True, window_size=(80, 60))
+        a = pl.add_spline(franke_c2c, lights=0, program_options={"roots": roots})
+        pl.camera_position = [(-0.6, -0.9, 1.4), (0.5, 0.5, 0.3), (0, 0, 1)]
+        pl.screenshot()
+        sources[roots] = a.program_sources["fragment"]
+        pl.close()
+    assert "return sv_first_root_bracketed(c, n, iterations);" in sources["bracketed"]
+    assert "return sv_first_root_newton4(c, n, iterations);" in sources["paper"]
+    assert "return sv_first_root_newton4(c, n, iterations);" not in sources["bracketed"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import check_degree
+from .._validation import check_choice, check_degree
 from ..gl.spec import ProgramSpec
 from .model import TerrainSpline
 
@@ -47,9 +47,11 @@ def minmax_atlas(terrain: TerrainSpline):
 
 
 def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_steps: int | None = None,
-                    hierarchy: bool | int = True) -> ProgramSpec:
+                    hierarchy: bool | int = True, roots: str = "bracketed") -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
+    ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (paper 000's
+    Newton from four secure starting points, compiled in with ``SV_ROOTS_PAPER_NEWTON``).
     ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
     int caps the top level (what the benchmarks use to measure the hierarchy's effect).
 
@@ -59,6 +61,7 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
+    check_choice(roots, "roots", {"bracketed", "paper"})
     ncy, ncx = terrain.shape
     if 8 * ncx > MAX_TEXTURE_WIDTH or ncy > MAX_TEXTURE_WIDTH:
         raise ValueError(
@@ -91,6 +94,7 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
         points=points,
         triangles=triangles,
         offset=tuple(off),
+        defines={"SV_ROOTS_PAPER_NEWTON": roots == "paper"},
         uniforms={
             "sv_level_offset[]": level_offsets,
             "sv_top_level": top,
