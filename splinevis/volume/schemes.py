@@ -1,0 +1,408 @@
+"""Quadratic super spline of volume data on the type-6 partition (Roessl et al. 2004; Nuernberger et
+al., CAGD 22 (2005); used on the GPU by Kalbe and Zeilfelder, paper 003). See docs/volume-schemes.md.
+
+Conventions
+-----------
+* ``volume[k, j, i]`` (shape ``(nz, ny, nx)``) is the data value ``f`` at the grid point with
+  *index-space* coordinates ``(x, y, z) = (i, j, k)`` (spacing 1). Points are always given as
+  ``(x, y, z)``.
+* Every data point is the centre of one cube ``Q_kji = [i - 1/2, i + 1/2] x [j - 1/2, j + 1/2] x
+  [k - 1/2, k + 1/2]``; the spline is defined on the union ``[-1/2, nx - 1/2] x [-1/2, ny - 1/2] x
+  [-1/2, nz - 1/2]`` of these ``nz * ny * nx`` cubes. Each cube carries 24 quadratic BB patches (the
+  tetrahedra of :mod:`splinevis.volume.partition`, local coordinates ``p - (i - 1/2, j - 1/2, k - 1/2)``)
+  with 10 coefficients each, in :func:`splinevis.bb.simplex.multi_indices` ``(2, 3)`` order w.r.t. the
+  vertices ``[vQ, wF, u, u']``.
+* The scheme needs the 27 data values around a cube; at the boundary the volume is padded by one layer
+  of linear extrapolation (``f[-1] = 2 f[0] - f[1]``), which keeps linear data linear.
+
+Determining set and the remaining coefficients
+----------------------------------------------
+The 20 domain points on the cube's edges get data averages: a cube vertex (surrounded by 8 grid points)
+gets the mean of those 8 values, an edge midpoint the mean of the 4 grid values around the edge. Both are
+exact for linear ``f``.  The other 45 coefficients are fixed linear combinations of the cube's 27-point
+data stencil, derived once by :func:`derive_weights` (linear algebra, float64, then snapped to the exact
+multiples of 1/16 they turn out to be):
+
+1. the 30 coefficients on the cube's boundary faces (``wF`` and ``(wF + u)/2``) from the C1 conditions
+   of the face restriction on the criss-cross split of the face; the solution is unique and depends only
+   on the face's 8 edge coefficients, so neighbouring cubes agree on their common face (C0 everywhere):
+   ``c((wF+u)/2)`` = mean of the two edge midpoints at u, ``c(wF)`` = mean of the 4 edge midpoints;
+2. the 15 inner coefficients (``vQ``, ``(vQ + wF)/2``, ``(vQ + u)/2``) as data weights subject to, exactly,
+   C1 across all 6 cube faces (as an identity in the data of both neighbouring cubes), reproduction of
+   linear functions, and, greedily in row order, as many C1 conditions across the inner faces of the split
+   as stay consistent (84 of 108); least squares over the remaining 24 conditions.
+   The C1 quadratic splines on one type-6 cube form a space of dimension 16 < 20, so the edge data cannot
+   in general be extended C1 inside the cube: the 12 faces ``[vQ, u, u']`` between different pyramids are
+   crossed C0 only (the normal-derivative jump is linear on the face and vanishes at vQ).
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+
+import numpy as np
+
+from .._validation import as_float64_array
+from ..bb import simplex as bb
+from .partition import NUM_TETS, _bary_mats, _locate, _tets
+
+__all__ = ["domain_points", "edge_points", "inner_face_conditions", "derive_weights",
+           "quadratic_super_spline", "evaluate", "NUM_DOMAIN_POINTS"]
+
+#: Distinct quadratic domain points of one type-6 cube.
+NUM_DOMAIN_POINTS = 65
+
+
+@functools.lru_cache(maxsize=None)
+def _domain():
+    v = _tets()
+    mi = bb._multi_indices(2, 3)
+    keys: dict = {}
+    tmap = np.zeros((NUM_TETS, 10), dtype=np.int64)
+    for t in range(NUM_TETS):
+        for q, a in enumerate(mi):
+            k = tuple(int(x) for x in np.round(2 * (a @ v[t])))  # 4 * domain point
+            keys.setdefault(k, len(keys))
+            tmap[t, q] = keys[k]
+    pts = np.array(sorted(keys, key=keys.get), dtype=np.float64) / 4.0
+    return pts, tmap, keys
+
+
+def domain_points():
+    """``(points (65, 3), tet_map (24, 10))``: the distinct domain points (local coordinates) and, for
+    every tetrahedron and BB coefficient, the index of its domain point."""
+    pts, tmap, _ = _domain()
+    return pts.copy(), tmap.copy()
+
+
+def edge_points() -> np.ndarray:
+    """Indices (into :func:`domain_points`) of the 20 determining points on the cube's edges, in
+    increasing order."""
+    pts = _domain()[0]
+    on = ((pts == 0) | (pts == 1)).sum(axis=1) >= 2
+    return np.flatnonzero(on)
+
+
+def _face_points():
+    pts = _domain()[0]
+    on = ((pts == 0) | (pts == 1)).sum(axis=1) == 1
+    return np.flatnonzero(on)
+
+
+def _idx(x):
+    return _domain()[2][tuple(int(v) for v in np.round(4 * np.asarray(x)))]
+
+
+@functools.lru_cache(maxsize=None)
+def _inner_faces():
+    v = _tets()
+    out = []
+    for t in range(NUM_TETS):
+        for s in range(t + 1, NUM_TETS):
+            shared = [w for w in v[t] if any(np.array_equal(w, z) for z in v[s])]
+            if len(shared) == 3:
+                out.append((t, s, np.array(shared)))
+    return out
+
+
+def inner_face_conditions():
+    """C1 conditions across the 36 inner faces of the split: ``(A (108, 65), pairs)`` with ``A @ c = 0``
+    for the 65 domain-point coefficients ``c`` of a spline that is C1 inside the cube; row ``3 m + r``
+    belongs to the face shared by tetrahedra ``pairs[m]``."""
+    v = _tets()
+    rows, pairs = [], []
+    for t, s, sh in _inner_faces():
+        e = [w for w in v[s] if not any(np.array_equal(w, z) for z in sh)][0]
+        lam = _bary_mats()[t][:, :3] @ e + _bary_mats()[t][:, 3]
+        for b in sh:  # c_s((e + b)/2) = sum_i lam_i c_t((v_i + b)/2)   (blossom form of the C1 condition)
+            r = np.zeros(NUM_DOMAIN_POINTS)
+            r[_idx((e + b) / 2)] += 1.0
+            for i in range(4):
+                r[_idx((v[t][i] + b) / 2)] -= lam[i]
+            rows.append(r)
+        pairs.append((t, s))
+    return np.array(rows), pairs
+
+
+def _face_conditions():
+    """2-D C1 conditions of the face restrictions (criss-cross split of each cube face), as rows over the
+    65 coefficients: across the face diagonal [wF, u'] of the triangles [wF, u, u'] and [wF, u', u'']
+    (u'' = 2 wF - u): c((u''+b)/2) = 2 c((wF+b)/2) - c((u+b)/2) for b in {wF, u'}."""
+    v = _tets()
+    rows = []
+    for f in range(6):
+        wf = v[4 * f, 1]
+        corners = [v[4 * f + k, 2] for k in range(4)]
+        for k in range(4):
+            u, up, upp = corners[k], corners[(k + 1) % 4], corners[(k + 2) % 4]
+            for b in (wf, up):
+                r = np.zeros(NUM_DOMAIN_POINTS)
+                r[_idx((upp + b) / 2)] += 1.0
+                r[_idx((wf + b) / 2)] -= 2.0
+                r[_idx((u + b) / 2)] += 1.0
+                rows.append(r)
+    return np.array(rows)
+
+
+def _solve_block(A, known, unknown, name):
+    """W with x_unknown = W @ x_known minimizing |A x|; refuse rank deficiency."""
+    Au, Ak = A[:, unknown], A[:, known]
+    rank = np.linalg.matrix_rank(Au)
+    if rank < len(unknown):
+        raise RuntimeError(f"{name}: the smoothness conditions do not determine the {len(unknown)} coefficients "
+                           f"(rank {rank}).")
+    W, *_ = np.linalg.lstsq(Au, -Ak, rcond=None)
+    return W
+
+
+#: Data offsets (x, y, z) of the 27-point stencil of a cube, z slowest, x fastest.
+STENCIL = np.array([(x, y, z) for z in (-1, 0, 1) for y in (-1, 0, 1) for x in (-1, 0, 1)], dtype=np.int64)
+_BIG = np.array([(x, y, z) for z in range(-2, 3) for y in range(-2, 3) for x in range(-2, 3)], dtype=np.int64)
+_BIG_ID = {tuple(int(v) for v in o): n for n, o in enumerate(_BIG)}
+_S27 = np.array([_BIG_ID[tuple(int(v) for v in o)] for o in STENCIL])
+
+
+def _edge_data_weights():
+    """(20, 27) data weights of the edge coefficients (cube centred at the data point 0)."""
+    pts = _domain()[0][edge_points()]
+    E = np.zeros((len(pts), 27))
+    sid = {tuple(int(v) for v in o): n for n, o in enumerate(STENCIL)}
+    for m, p in enumerate(pts):
+        g = p - 0.5
+        rng = [[0] if gg == 0 else [int(np.floor(gg)), int(np.ceil(gg))] for gg in g]
+        w = 1.0 / np.prod([len(r) for r in rng])
+        for o in itertools.product(*rng):
+            E[m, sid[o]] += w
+    return E
+
+
+def _lift(M27, shift):
+    """(..., 27) stencil weights of the cube at offset `shift` -> (..., 125) weights on offsets -2..2."""
+    out = np.zeros(M27.shape[:-1] + (125,))
+    for j, o in enumerate(STENCIL):
+        out[..., _BIG_ID[tuple(int(v) for v in o + shift)]] += M27[..., j]
+    return out
+
+
+def _snap(w):
+    """The derived weights are multiples of 1/16: remove the solvers' rounding noise (only if tiny)."""
+    s = np.round(w * 2.0**10) / 2.0**10
+    return s if np.abs(s - w).max() < 1e-9 else w
+
+
+@functools.lru_cache(maxsize=None)
+def _weights():
+    """Derivation (see the module docstring and docs/volume-schemes.md). Returns (W (65, 27), diagnostics)."""
+    n = NUM_DOMAIN_POINTS
+    pts = _domain()[0]
+    edge, face = edge_points(), _face_points()
+    inner = np.setdiff1d(np.arange(n), np.concatenate([edge, face]))
+    known = np.concatenate([edge, face])
+    # 1. face coefficients from the criss-cross C1 conditions of each face (unique, consistent)
+    F = _face_conditions()
+    Wf = _solve_block(F, edge, face, "face coefficients")
+    face_res = float(np.abs(F[:, face] @ Wf + F[:, edge]).max())
+    if face_res > 1e-13:
+        raise RuntimeError(f"face C1 conditions are inconsistent (residual {face_res:.3g}).")
+    E = _edge_data_weights()
+    K = np.zeros((n, 27))
+    K[edge] = E
+    K[face] = _snap(Wf @ E)
+    # 2. inner coefficients: unknown data weights X (15, 27), vector x = X.ravel()
+    ni = len(inner)
+    nx = ni * 27
+    iid = {int(k): m for m, k in enumerate(inner)}
+
+    def inner_rows(p, shift):  # (125, nx): weights of inner coefficient p of the cube at `shift`
+        M = np.zeros((125, nx))
+        for j, o in enumerate(STENCIL):
+            M[_BIG_ID[tuple(int(v) for v in o + shift)], iid[p] * 27 + j] = 1.0
+        return M
+
+    v = _tets()
+    vq = np.full(3, 0.5)
+    hard, hard_rhs = [], []
+    # (a) C1 across the 6 cube faces: c(wF) and c((wF+u)/2) are the means of the two coefficients on
+    #     either side (neighbour centre 2 wF - vQ), an identity in the data of both cubes' stencils
+    for f in range(6):
+        a, s = divmod(f, 2)
+        d = np.zeros(3, dtype=np.int64)
+        d[a] = 2 * s - 1
+        wf = v[4 * f, 1]
+        for target in [wf] + [v[4 * f + k, 2] for k in range(4)]:
+            fp = _idx((wf + target) / 2)
+            hard.append(inner_rows(_idx((vq + target) / 2), np.zeros(3, dtype=np.int64))
+                        + inner_rows(_idx((vq + target - d) / 2), d))
+            hard_rhs.append(2 * _lift(K[fp], np.zeros(3, dtype=np.int64)))
+    # (b) reproduction of linear functions
+    for m, p in enumerate(inner):
+        for mono in range(4):
+            r = np.zeros((1, nx))
+            r[0, m * 27:(m + 1) * 27] = 1.0 if mono == 0 else STENCIL[:, mono - 1]
+            hard.append(r)
+            hard_rhs.append(np.array([1.0 if mono == 0 else pts[p][mono - 1] - 0.5]))
+    # (c) inner C1 conditions, as identities in the data
+    A, pairs = inner_face_conditions()
+    soft, soft_rhs = [], []
+    for r in range(A.shape[0]):
+        M = np.zeros((125, nx))
+        for m, p in enumerate(inner):
+            if A[r, p] != 0:
+                M[_S27, m * 27:(m + 1) * 27] += A[r, p] * np.eye(27)
+        soft.append(M)
+        soft_rhs.append(-_lift(A[r, known] @ K[known], np.zeros(3, dtype=np.int64)))
+    H, h = np.vstack(hard), np.concatenate(hard_rhs)
+    keep = np.abs(H).sum(axis=1) + np.abs(h) > 0
+    H, h = H[keep], h[keep]
+    x0, *_ = np.linalg.lstsq(H, h, rcond=None)
+    if np.abs(H @ x0 - h).max() > 1e-12:
+        raise RuntimeError("cube-face C1 + linear reproduction is inconsistent: refusing.")
+    _, sv, vt = np.linalg.svd(H)
+    N = vt[int(np.sum(sv > 1e-10 * sv[0])):].T  # solutions: x0 + N y
+    # greedily impose inner C1 conditions (in row order) that stay consistent with the imposed ones
+    added = []
+    for r in range(A.shape[0]):
+        R, b = soft[r], soft_rhs[r]
+        RN = R @ N
+        y, *_ = np.linalg.lstsq(RN, b - R @ x0, rcond=None)
+        if np.abs(RN @ y + R @ x0 - b).max() < 1e-10:
+            x0 = x0 + N @ y
+            _, sv, vt = np.linalg.svd(RN)
+            rk = int(np.sum(sv > 1e-10 * max(sv[0], 1.0))) if sv.size else 0
+            N = N @ vt[rk:].T
+            added.append(r)
+    rest = [r for r in range(A.shape[0]) if r not in added]
+    x = x0
+    if rest and N.shape[1]:  # least squares over the conditions that cannot hold ("averaging")
+        O = np.vstack([soft[r] for r in rest])
+        o = np.concatenate([soft_rhs[r] for r in rest])
+        y, *_ = np.linalg.lstsq(O @ N, o - O @ x0, rcond=None)
+        x = x0 + N @ y
+    x = _snap(x)
+    Hall = np.vstack([np.vstack(hard)] + [soft[r] for r in added])
+    hall = np.concatenate([np.concatenate(hard_rhs)] + [soft_rhs[r] for r in added])
+    W = K.copy()
+    W[inner] = x.reshape(ni, 27)
+    res = np.array([np.abs(soft[r] @ x - soft_rhs[r]).max() for r in range(A.shape[0])])
+    exact = res < 1e-10
+    W.setflags(write=False)
+    return W, exact, pairs, face_res, float(np.abs(Hall @ x - hall).max())
+
+
+def derive_weights() -> dict:
+    """The coefficient map of the scheme and its diagnostics.
+
+    Returns
+    -------
+    dict with
+        ``"W"``: (65, 27) data weights: coefficient at domain point m = ``W[m] @ data[STENCIL offsets]``;
+        ``"exact_conditions"``: (108,) bool, which rows of :func:`inner_face_conditions` hold for all data;
+        ``"exact_faces"``: list of the tetrahedron pairs whose common face is crossed C1 for all data;
+        ``"face_residual"``: residual of the face (criss-cross) C1 solve;
+        ``"hard_residual"``: residual of the exactly imposed conditions (cube-face C1, linear
+        reproduction, the inner C1 conditions flagged exact).
+    """
+    W, exact, pairs, face_res, hard_res = _weights()
+    ex_faces = [pairs[m] for m in range(len(pairs)) if exact[3 * m:3 * m + 3].all()]
+    return {"W": W.copy(), "exact_conditions": exact.copy(), "exact_faces": ex_faces, "face_residual": face_res,
+            "hard_residual": hard_res}
+
+
+def _check_volume(volume):
+    vol = as_float64_array(volume, "volume", finite=False)
+    if vol.ndim != 3:
+        raise ValueError(f"volume must be a 3-D array of shape (nz, ny, nx) with volume[k, j, i] the value at "
+                         f"(x, y, z) = (i, j, k); got {vol.ndim}-D shape {vol.shape}.")
+    if min(vol.shape) < 2:
+        raise ValueError(f"volume must have at least 2 samples along every axis (linear extrapolation at the "
+                         f"boundary needs two); got shape {vol.shape}.")
+    bad = ~np.isfinite(vol)
+    if bad.any():
+        k, j, i = (int(v) for v in np.argwhere(bad)[0])
+        raise ValueError(f"volume must be finite; found {int(bad.sum())} non-finite value(s), the first, "
+                         f"{float(vol[k, j, i])!r}, at voxel [k, j, i] = [{k}, {j}, {i}] (x={i}, y={j}, z={k}).")
+    return vol
+
+
+def _pad(vol):
+    p = np.pad(vol, 1, mode="edge")
+    for ax in range(3):
+        p = np.moveaxis(p, ax, 0)
+        p[0] = 2 * p[1] - p[2]
+        p[-1] = 2 * p[-2] - p[-3]
+        p = np.moveaxis(p, 0, ax)
+    return p
+
+
+def _stencil_data(vol):
+    """(nz, ny, nx, 27) data of every cube's 27-point stencil (padded volume)."""
+    P = _pad(vol)
+    nz, ny, nx = vol.shape
+    return np.stack([P[1 + oz:1 + oz + nz, 1 + oy:1 + oy + ny, 1 + ox:1 + ox + nx] for ox, oy, oz in STENCIL], axis=-1)
+
+
+def quadratic_super_spline(volume) -> np.ndarray:
+    """BB coefficients of the quadratic super spline of ``volume``.
+
+    Parameters
+    ----------
+    volume : (nz, ny, nx) array_like, finite, every axis >= 2
+        ``volume[k, j, i]`` = f at index-space point (x, y, z) = (i, j, k).
+
+    Returns
+    -------
+    (nz, ny, nx, 24, 10) float64 ndarray
+        Cube ``[k, j, i]`` is centred at the data point (i, j, k); patch t is tetrahedron t of
+        :func:`splinevis.volume.partition.type6_tetrahedra`, coefficients in ``multi_indices(2, 3)`` order.
+    """
+    vol = _check_volume(volume)
+    W = _weights()[0]
+    _, tmap, _ = _domain()
+    allc = _stencil_data(vol) @ W.T  # (nz, ny, nx, 65)
+    return allc[..., tmap]
+
+
+def _check_coef(coef):
+    c = as_float64_array(coef, "coef")
+    if c.ndim != 5 or c.shape[3:] != (NUM_TETS, 10):
+        raise ValueError(f"coef must have shape (nz, ny, nx, 24, 10); got {c.shape}.")
+    return c
+
+
+def evaluate(coef, points, *, gradient: bool = False, tol: float = 1e-9):
+    """Evaluate the spline (and optionally its gradient) at index-space points.
+
+    Parameters
+    ----------
+    coef : (nz, ny, nx, 24, 10) array_like
+        From :func:`quadratic_super_spline`.
+    points : (..., 3) array_like
+        Points ``(x, y, z)`` in ``[-1/2, nx - 1/2] x [-1/2, ny - 1/2] x [-1/2, nz - 1/2]`` (up to tol).
+    gradient : bool
+        Also return the gradient ``(..., 3)`` (d/dx, d/dy, d/dz) of the patch containing the point.
+
+    Returns
+    -------
+    values (...), or (values, gradients (..., 3)).
+    """
+    c = _check_coef(coef)
+    p = as_float64_array(points, "points", shape_tail=(3,))
+    nz, ny, nx = c.shape[:3]
+    hi = np.array([nx, ny, nz], dtype=np.float64) - 0.5
+    out = (p < -0.5 - tol) | (p > hi + tol)
+    if out.any():
+        idx = tuple(int(v) for v in np.argwhere(out.any(axis=-1))[0]) if p.ndim > 1 else ()
+        raise ValueError(f"points must lie in the spline domain [-1/2, n - 1/2] per axis (x: nx={nx}, y: ny={ny}, "
+                         f"z: nz={nz}); the point at index {idx} is {p[idx].tolist()}.")
+    cell = np.clip(np.floor(p + 0.5), 0, hi - 0.5).astype(np.int64)
+    local = np.clip(p - (cell - 0.5), 0.0, 1.0)
+    t, lam = _locate(local)
+    cc = c[cell[..., 2], cell[..., 1], cell[..., 0], t]  # (..., 10)
+    val = bb._decasteljau(cc, 2, 3, lam)
+    if not gradient:
+        return val
+    g = bb.gradient(cc, d=3)  # (..., 4, 4): d p / d lam_i as degree-1 coefficients
+    dlam = bb._decasteljau(g, 1, 3, lam[..., None, :])  # (..., 4)
+    grad = np.einsum("...i,...ij->...j", dlam, _bary_mats()[t][..., :3])
+    return val, grad
