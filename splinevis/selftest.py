@@ -214,6 +214,18 @@ def _bern_abs_sum(c, t, n):
     return _simplex._decasteljau(np.abs(c), n, 1, tt)
 
 
+def _jet(c, n, t):
+    """f, S = sum |c_k| B_k, f' and f'' of BB polynomials c (M, n + 1) at t (M,) in float64 (NaN t -> 0.5)."""
+    tt = np.where(np.isfinite(t), t, 0.5)
+    tt = np.stack([1.0 - tt, tt], axis=-1)
+    f = _simplex._decasteljau(c, n, 1, tt)
+    S = _simplex._decasteljau(np.abs(c), n, 1, tt)
+    fp = n * _simplex._decasteljau(c[:, 1:] - c[:, :-1], n - 1, 1, tt)
+    fpp = (n * (n - 1) * _simplex._decasteljau(c[:, 2:] - 2 * c[:, 1:-1] + c[:, :-2], n - 2, 1, tt)
+           if n >= 2 else np.zeros_like(f))
+    return f, S, fp, fpp
+
+
 def classify_first_roots(c, x, n: int, absolute_bound: float = 0.0, ref=None) -> dict:
     """Classify computed first roots ``x`` (NaN = none) of ``c`` (M, n+1) against :func:`roots_reference`.
 
@@ -234,14 +246,7 @@ def classify_first_roots(c, x, n: int, absolute_bound: float = 0.0, ref=None) ->
     K = _roots.root_tolerance_k(n)
 
     def jet(t):
-        tt = np.where(np.isfinite(t), t, 0.5)
-        tt = np.stack([1.0 - tt, tt], axis=-1)
-        f = _simplex._decasteljau(c, n, 1, tt)
-        S = _simplex._decasteljau(np.abs(c), n, 1, tt)
-        fp = n * _simplex._decasteljau(c[:, 1:] - c[:, :-1], n - 1, 1, tt)
-        fpp = (n * (n - 1) * _simplex._decasteljau(c[:, 2:] - 2 * c[:, 1:-1] + c[:, :-2], n - 2, 1, tt)
-               if n >= 2 else np.zeros_like(f))
-        return f, S, fp, fpp
+        return _jet(c, n, t)
 
     with np.errstate(all="ignore"):
         f, S, fp, fpp = jet(rf)
@@ -345,14 +350,7 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
     ev = EVAL_BOUND(n)
 
     def jet(x):
-        xx = np.where(np.isfinite(x), x, 0.5)
-        tt = np.stack([1.0 - xx, xx], axis=-1)
-        f = _simplex._decasteljau(c, n, 1, tt)
-        S = _simplex._decasteljau(np.abs(c), n, 1, tt)
-        fp = n * _simplex._decasteljau(c[:, 1:] - c[:, :-1], n - 1, 1, tt)
-        fpp = (n * (n - 1) * _simplex._decasteljau(c[:, 2:] - 2 * c[:, 1:-1] + c[:, :-2], n - 2, 1, tt)
-               if n >= 2 else np.zeros_like(f))
-        return f, S, fp, fpp
+        return _jet(c, n, x)
 
     gf, tf = np.isfinite(g), np.isfinite(tw)
     both = gf & tf

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bounds import ray_depth_error_bound
 from .rays import pixel_rays, window_depth
 
 __all__ = ["front_surface_agreement", "patch_depth_agreement"]
@@ -82,44 +81,12 @@ def front_surface_agreement(window_size=(640, 480)) -> dict:
     }
 
 
-def depth_error_bound(patch, matrix, origins, directions, t) -> np.ndarray:
-    """Per-pixel bound on |GPU depth - float64 depth| for the analytic patch (see
-    :func:`splinevis.analysis.bounds.ray_depth_error_bound`)."""
-    p = np.asarray(origins) + t[..., None] * np.asarray(directions)
-    extent = np.abs(patch.vertices).max(axis=0)  # rays start on the proxy: coordinates are bounded by it
-    return ray_depth_error_bound(lambda q: patch.gradient(q), float(np.abs(patch.coefficients).max()), matrix,
-                                 origins, directions, t, np.broadcast_to(extent, p[..., :2].shape),
-                                 proxy_size=float(np.ptp(patch.vertices, axis=0).max() + np.ptp(patch.zrange)))
+def patch_depth_agreement(window_size=(640, 480), camera=None, newton_iterations=8) -> dict:
+    """Render the showcase patch alone; compare hit/miss and window depth with the float64 reference
+    (:func:`splinevis.analysis.agreement.depth_agreement` at the showcase camera)."""
+    from ..analytic import QuarticTrianglePatch
+    from ..studies.demo import CAMERA
+    from .agreement import depth_agreement
 
-
-def patch_depth_agreement(window_size=(640, 480), camera=None, newton_iterations=6) -> dict:
-    """Render the patch alone; compare hit/miss and window depth with the float64 reference."""
-    from ..studies.demo import composite_scene
-
-    w, h = window_size
-    pl, patch, _ = composite_scene(window_size, style=dict(lights=0, color=(1.0, 0.0, 0.0)), sphere=False)
-    if camera is not None:
-        pl.camera_position = camera
-        pl.reset_camera_clipping_range()
-    pl.screenshot()
-    gpu = pl.depth_buffer()
-    matrix = pl.camera_matrix()
-    pl.close()
-    o, d = pixel_rays(matrix, w, h)
-    hits = patch.raycast(o, d, 0.0, method="reference")
-    ref = window_depth(matrix, o + hits.t[..., None] * d)
-    gpu_hit = gpu < 1.0
-    ref_hit = np.isfinite(ref)
-    both = gpu_hit & ref_hit
-    bound = depth_error_bound(patch, matrix, o[both], d[both], hits.t[both])
-    return {
-        "depth_bound": bound,
-        "gpu_depth": gpu,
-        "reference_depth": ref,
-        "hit_disagree": int((gpu_hit != ref_hit).sum()),
-        "pixels": w * h,
-        "both": int(both.sum()),
-        "depth_error": np.abs(gpu - ref)[both],
-        "matrix": matrix,
-        "patch": patch,
-    }
+    return depth_agreement(QuarticTrianglePatch.demo(), camera if camera is not None else CAMERA, window_size,
+                           newton_iterations=newton_iterations)
