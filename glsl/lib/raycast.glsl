@@ -8,6 +8,9 @@
 // The proxy geometry is rasterized with front faces culled, so each fragment lies on the far side of
 // the proxy and the camera may sit inside it.
 
+// The "no hit" ray parameter of every program (larger than any real t).
+const float SV_NO_HIT = 3.0e38;
+
 struct SvHit {
     vec3 pos;
     vec3 normal;

@@ -269,3 +269,39 @@ float sv_first_root(float c[5], int n, int iterations) {
     return sv_first_root_bracketed(c, n, iterations);
 #endif
 }
+
+// ------------------------------------------------------------------------------------------------------
+// Closed form for quadratics (paper 003, sec. 5.3: "well known formulae [HE95] ... in an analytical and
+// stable way").  f(t) = c0 (1-t)^2 + 2 c1 (1-t) t + c2 t^2 = A t^2 + B t + C with A = c0 - 2 c1 + c2,
+// B = 2 (c1 - c0), C = c0.  Roots by q = -(B + sign(B) sqrt(B^2 - 4 A C)) / 2, t = q / A and C / q (no
+// cancellation between B and the square root).  A negative discriminant within rounding of a touching
+// parabola (|f(t*)| <= tol at the vertex t* = -B / (2A), tol the residual test above) returns t*: a ray
+// tangent to the isosurface is a (double) root, not a miss.  Smallest root in [0, 1], -1.0 if none.
+// The float64 twin is splinevis.bb.roots.first_root_quadratic.
+float sv_first_root_quadratic(float c[5]) {
+    float A = c[0] - 2.0 * c[1] + c[2];
+    float B = 2.0 * (c[1] - c[0]);
+    float C = c[0];
+    if (C == 0.0) return 0.0;
+    float best = 2.0;
+    float disc = B * B - 4.0 * A * C;
+    if (A == 0.0) {
+        float r = (B != 0.0) ? -C / B : -1.0;
+        if (r >= 0.0 && r <= 1.0) best = r;
+    } else if (disc >= 0.0) {
+        float q = -0.5 * (B + (B >= 0.0 ? 1.0 : -1.0) * sqrt(disc));
+        float r1 = q / A;
+        float r2 = (q != 0.0) ? C / q : r1;
+        if (r1 >= 0.0 && r1 <= 1.0) best = min(best, r1);
+        if (r2 >= 0.0 && r2 <= 1.0) best = min(best, r2);
+    } else {
+        float ts = -B / (2.0 * A);
+        if (ts >= 0.0 && ts <= 1.0) {
+            float s = 1.0 - ts;
+            float f = c[0] * s * s + 2.0 * c[1] * s * ts + c[2] * ts * ts;
+            float S = abs(c[0]) * s * s + 2.0 * abs(c[1]) * s * ts + abs(c[2]) * ts * ts;
+            if (abs(f) <= sv_root_tol_k(2) * SV_ROOT_EPS32 * S) best = ts;
+        }
+    }
+    return (best <= 1.0) ? best : -1.0;
+}

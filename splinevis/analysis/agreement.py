@@ -11,17 +11,27 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from .bounds import ray_depth_error_bound
+from .bounds import isosurface_depth_error_bound, ray_depth_error_bound
 from .rays import pixel_rays, window_depth
 
 __all__ = ["depth_agreement", "reference_hits"]
 
 
 def reference_hits(model, origins, directions, *, method="reference"):
-    """Float64 ray cast of a supported model (analytic patch or terrain)."""
+    """Float64 ray cast of a supported model (analytic patch, terrain or isosurface)."""
+    from types import SimpleNamespace
+
     from ..analytic import QuarticTrianglePatch
     from ..terrain.model import TerrainSpline
     from ..terrain.raycast import raycast_terrain
+    from ..volume.program import Isosurface
+    from ..volume.raycast import raycast_isosurface
+
+    if isinstance(model, Isosurface):
+        shape = np.shape(origins)[:-1]
+        t, normal = raycast_isosurface(model, np.reshape(origins, (-1, 3)), np.reshape(directions, (-1, 3)),
+                                       method=method)
+        return SimpleNamespace(t=t.reshape(shape), normal=normal.reshape(shape + (3,)))
 
     if isinstance(model, QuarticTrianglePatch):
         return model.raycast(origins, directions, 0.0, method=method)
@@ -32,6 +42,17 @@ def reference_hits(model, origins, directions, *, method="reference"):
 
 def _bound(model, matrix, o, d, t):
     from ..analytic import QuarticTrianglePatch
+    from ..volume.program import Isosurface, value_reference
+
+    if isinstance(model, Isosurface):
+        sp = model.spline
+        off = sp.origin
+        lo, hi = sp.value_range
+        ref = value_reference(sp)
+        scale = max(abs(hi - ref), abs(lo - ref), abs(model.isovalue - ref))
+        b = np.array(sp.bounds).reshape(3, 2) - off[:, None]
+        return isosurface_depth_error_bound(lambda q: sp.evaluate(q + off, gradient=True), scale, sp.spacing,
+                                            _shift(matrix, off), o - off, d, t, float(np.abs(b).max()), sp.degree)
 
     p = o + t[..., None] * d
     # The shader's rays start on the far side of the proxy (lib/raycast.glsl), so the coordinates it

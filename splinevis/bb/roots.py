@@ -26,6 +26,7 @@ import numpy as np
 from .._validation import as_float64_array, check_degree
 
 __all__ = [
+    "first_root_quadratic",
     "MAX_ROOT_DEGREE",
     "EPS32",
     "root_tolerance_k",
@@ -582,3 +583,54 @@ def roots_reference(c) -> np.ndarray:
 def first_root_reference(c) -> np.ndarray:
     """Smallest root in [0, 1] by :func:`roots_reference`, NaN if none; shape ``c.shape[:-1]``."""
     return roots_reference(c)[..., 0]
+
+
+def first_root_quadratic(c, *, dtype=np.float64):
+    """First root in [0, 1] of a quadratic BB polynomial by the stable closed form (NaN if none).
+
+    Mirrors ``sv_first_root_quadratic`` in ``glsl/lib/roots.glsl`` operation by operation:
+    ``f = A t^2 + B t + C`` with ``A = c0 - 2 c1 + c2``, ``B = 2 (c1 - c0)``, ``C = c0``;
+    ``q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2``, roots ``q / A`` and ``C / q``; ``c0 = 0`` gives 0; ``A = 0``
+    the linear root ``-C / B``; a negative discriminant returns the vertex ``-B / (2A)`` if it passes the
+    residual test ``|f| <= K_2 EPS32 sum |c_k| B_k`` (a tangent ray), else nothing.
+
+    Parameters
+    ----------
+    c : (..., 3) array_like
+        BB coefficients.
+    dtype : numpy float type
+        np.float32 reproduces the GPU's arithmetic; np.float64 is the reference precision.
+    """
+    c = _check_univariate(c, high=2)
+    if c.shape[-1] != 3:
+        raise ValueError(f"first_root_quadratic needs 3 coefficients (degree 2), got {c.shape[-1]}.")
+    dt = _check_dtype(dtype)
+    c = c.astype(dt)
+    two, half = dt(2.0), dt(0.5)
+    with np.errstate(all="ignore"):
+        A = c[..., 0] - two * c[..., 1] + c[..., 2]
+        B = two * (c[..., 1] - c[..., 0])
+        C = c[..., 0]
+        disc = B * B - dt(4.0) * A * C
+        sq = np.sqrt(np.maximum(disc, dt(0)))
+        q = -half * (B + np.where(B >= 0, dt(1), dt(-1)) * sq)
+        r1 = q / A
+        r2 = np.where(q != 0, C / q, r1)
+        lin = -C / B
+        ts = -B / (two * A)
+        s = dt(1) - ts
+        f = c[..., 0] * s * s + two * c[..., 1] * s * ts + c[..., 2] * ts * ts
+        S = np.abs(c[..., 0]) * s * s + two * np.abs(c[..., 1]) * s * ts + np.abs(c[..., 2]) * ts * ts
+        touch = np.abs(f) <= dt(root_tolerance_k(2) * EPS32) * S
+
+        def ok(r):
+            return (r >= 0) & (r <= 1)
+
+        best = np.full(A.shape, np.inf, dtype=dt)
+        quad = (A != 0) & (disc >= 0)
+        best = np.where(quad & ok(r1), np.minimum(best, r1), best)
+        best = np.where(quad & ok(r2), np.minimum(best, r2), best)
+        best = np.where((A == 0) & (B != 0) & ok(lin), lin, best)
+        best = np.where((A != 0) & (disc < 0) & ok(ts) & touch, ts, best)
+        best = np.where(C == 0, dt(0), best)
+    return np.where(best <= 1, best, np.nan).astype(np.float64)

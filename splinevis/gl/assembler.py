@@ -228,8 +228,13 @@ def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
             origins.append(("<defines>", 0))
     seen: list[str] = []
 
+    defined = {n for n, v in key if v is not False}
+
     def expand(lines: list[str], rel: str, chain: tuple):
-        for i, line in enumerate(lines, start=1):
+        # Resolve this file's SV_ conditionals first, so an #include in a disabled branch is never read:
+        # a scheme or effect that is not declared pulls in none of its files.
+        kept, where = _strip_sv_conditionals(list(lines), [(rel, i) for i in range(1, len(lines) + 1)], defined, rel)
+        for line, (_, i) in zip(kept, where):
             m = _INCLUDE.match(line)
             if not m:
                 out.append(line)
@@ -251,6 +256,5 @@ def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
     else:
         seen.append(entry)
         expand(_read(root, entry, ()), entry, (entry,))
-    defined = {n for n, v in key if v is not False}
     out, origins = _strip_sv_conditionals(out, origins, defined, name)
     return Assembled(name=name, defines=key, text="\n".join(out) + "\n", origins=tuple(origins), files=tuple(seen))

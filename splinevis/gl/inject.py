@@ -230,7 +230,9 @@ class SplineActor:
         mapper.SetVBOShiftScaleMethod(0)  # DISABLE_SHIFT_SCALE: vertexMC must be model coordinates
         vs_dec, vs_impl = _VS_DEC, _VS_IMPL
         fs_dec = _FS_DEC
-        for name, values in spec.attributes.items():
+        per_vertex = [(name, values, "flat ") for name, values in spec.attributes.items()]
+        per_vertex += [(name, values, "") for name, values in spec.varyings.items()]
+        for name, values, qualifier in per_vertex:
             arr = np.asarray(values, dtype=np.float32)
             if arr.ndim == 1:
                 arr = arr[:, None]
@@ -242,9 +244,9 @@ class SplineActor:
             vtk_arr.SetName(name)
             poly.GetPointData().AddArray(vtk_arr)
             mapper.MapDataArrayToVertexAttribute(name, name, 0, -1)
-            vs_dec += f"in {vtype} {name};\nflat out {vtype} {name}VSOut;\n"
+            vs_dec += f"in {vtype} {name};\n{qualifier}out {vtype} {name}VSOut;\n"
             vs_impl += f"  {name}VSOut = {name};\n"
-            fs_dec += f"flat in {vtype} {name}VSOut;\n"
+            fs_dec += f"{qualifier}in {vtype} {name}VSOut;\n"
         self.mapper = mapper
 
         actor = vtkActor()

@@ -33,6 +33,11 @@ class ProgramSpec:
     attributes : dict
         name -> (N, k <= 4) float array per proxy vertex; declared ``in`` in the vertex shader and
         forwarded to the fragment shader as ``<name>VSOut`` (flat).
+    varyings : dict
+        name -> (N, k <= 4) float array per proxy vertex, interpolated (perspective-correct) across each
+        proxy triangle and read in the fragment shader as ``<name>VSOut``. The isosurface program passes
+        cube-local corner coordinates this way, so every fragment knows its position relative to its own
+        cube to float32 precision whatever the volume's size.
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
     offset : (3,) float64, optional
@@ -49,5 +54,6 @@ class ProgramSpec:
     uniforms: dict = field(default_factory=dict)
     textures: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
+    varyings: dict = field(default_factory=dict)
     frame_uniforms: Callable | None = None
     offset: tuple = (0.0, 0.0, 0.0)

@@ -1,0 +1,178 @@
+// Ray casting the isosurface s = isovalue of a quadratic or cubic spline on the type-6 partition, per
+// fragment (paper 003, sec. 5).
+//
+// Proxy: one box per relevant cube (splinevis.volume.program), rasterized with front faces culled, so
+// each fragment lies on the cube's far side and the camera may be inside the volume. The fragment tests
+// the relevant tetrahedra of its own cube (bit mask, a flat vertex attribute):
+// 1. clip the ray by the tetrahedron's barycentric coordinates (paper 003, sec. 5.3: lam_i >= 0), with a
+//    margin against cracks between neighbours;
+// 2. BB coefficients of s on the tetrahedron: recomputed from the cube's 27 data values with the scheme's
+//    averaging rules (encoding "data", the determining data of paper 003 sec. 5.1 taken to the limit: one
+//    value per cube) or read from a table (encoding "coefficients": every coefficient stored);
+// 3. restriction to the segment by blossoming (Fig. 10), isovalue subtracted, first root in [0, 1]:
+//    quadratic by the stable closed form, cubic by bracketed Newton (default) or paper 003's Newton from
+//    three starts (SV_ROOTS_PAPER_NEWTON);
+// 4. the smallest t over the tetrahedra wins in the cube; across cubes the depth test picks the first.
+// Normal: gradient of s from the degree n - 1 coefficients at the hit (paper 003, sec. 5.3, last para).
+// The float64 twin is splinevis.volume.raycast.
+#include "lib/raycast.glsl"
+#include "lib/roots.glsl"
+#include "lib/type6.glsl"
+#include "lib/tet_steps.glsl"
+#ifdef SV_VOLUME_CUBIC
+#include "lib/volume_stencil_cubic.glsl"
+#else
+#include "lib/volume_stencil_quadratic.glsl"
+#endif
+
+uniform vec3 sv_inv_spacing;      // index-space direction = sv_inv_spacing * model-space direction
+uniform float sv_iso_shifted;     // isovalue - sv_value_ref (the textures hold data - sv_value_ref)
+uniform float sv_value_ref;
+uniform int sv_newton_iterations;
+uniform float sv_tet_margin;      // clip margin in barycentric units
+uniform int sv_tex_width;         // texels per row of the data / coefficient texture
+uniform vec3 sv_padded_dims;      // (nx + 2, ny + 2, nz + 2)
+uniform vec3 sv_cube_count;       // (nx, ny, nz): hit.uv = (x, y) / (nx, ny)
+
+float sv_fetch_linear(int n) {
+    int texel = n / 4;
+#ifdef SV_VOLUME_TABLE
+    vec4 v = texelFetch(sv_volume_coef, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+#else
+    vec4 v = texelFetch(sv_volume_data, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+#endif
+    return v[n - 4 * texel];
+}
+
+#ifdef SV_VOLUME_TABLE
+// Coefficients of the cube's r-th relevant tetrahedron, row (first row of the cube) + r of the table.
+void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
+    int row = 4096 * int(sv_cube_extraVSOut.y + 0.5) + int(sv_cube_extraVSOut.z + 0.5);
+    int base = (row + r) * SV_VOL_NCOEF;
+    for (int q = 0; q < SV_VOL_NCOEF; ++q) b[q] = sv_fetch_linear(base + q);
+}
+#else
+void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
+    sv_tet_coefficients(t, f, b);
+}
+#endif
+
+// The cube's 27 data values (padded volume, x fastest), stencil order of splinevis.volume.schemes.STENCIL.
+void sv_load_stencil(ivec3 c, out float f[27]) {
+#ifdef SV_VOLUME_TABLE
+    for (int s = 0; s < 27; ++s) f[s] = 0.0;
+#else
+    ivec3 dims = ivec3(sv_padded_dims + 0.5);
+    int s = 0;
+    for (int dz = 0; dz < 3; ++dz) {
+        for (int dy = 0; dy < 3; ++dy) {
+            int row = ((c.z + dz) * dims.y + (c.y + dy)) * dims.x + c.x;
+            for (int dx = 0; dx < 3; ++dx) {
+                f[s] = sv_fetch_linear(row + dx);
+                s += 1;
+            }
+        }
+    }
+#endif
+}
+
+float sv_first_root_deg(float c[5]) {
+#if !defined(SV_VOLUME_CUBIC) && !defined(SV_ROOTS_PAPER_NEWTON) && !defined(SV_ROOTS_BRACKETED)
+    return sv_first_root_quadratic(c);
+#else
+    return sv_first_root(c, SV_VOL_DEGREE, sv_newton_iterations);
+#endif
+}
+
+void sv_restrict(float b[SV_VOL_NCOEF], vec4 l0, vec4 l1, out float c[5]) {
+#ifdef SV_VOLUME_CUBIC
+    sv_restrict_tet3(b, l0, l1, c);
+#else
+    sv_restrict_tet2(b, l0, l1, c);
+#endif
+}
+
+// Gradient in cube-local coordinates of tetrahedron t's polynomial at barycentric point l, and its value.
+vec3 sv_tet_gradient(float b[SV_VOL_NCOEF], int t, vec4 l, out float value) {
+    float a[4];
+#ifdef SV_VOLUME_CUBIC
+    float a2[10];
+    sv_tet_step3(b, l, a2);
+    sv_tet_step2(a2, l, a);
+#else
+    sv_tet_step2(b, l, a);
+#endif
+    value = sv_tet_step1(a, l);
+    vec3 g = vec3(0.0);
+    for (int i = 0; i < 4; ++i) g += a[i] * SV_TET_BARY[4 * t + i].xyz;
+    return float(SV_VOL_DEGREE) * g;
+}
+
+bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    hit.curvature = vec2(0.0);
+    hit.depth = 0.0;
+    ivec3 c = ivec3(sv_cubeVSOut.xyz + 0.5);
+    int mask = int(sv_cubeVSOut.w + 0.5) + 4096 * int(sv_cube_extraVSOut.x + 0.5);
+    // The ray in cube-local coordinates: the interpolated local position of this fragment (exact at the
+    // proxy's corners) and the direction in index units; t is the model-space parameter of ro + t rd.
+    vec3 P0 = sv_localVSOut;
+    vec3 D = sv_inv_spacing * rd;
+    float f[27];
+    sv_load_stencil(c, f);
+    float t_best = SV_NO_HIT;
+    int tet_best = -1;
+    int r = 0;   // rank of t among the cube's relevant tetrahedra (row in the coefficient table)
+    for (int t = 0; t < 24; ++t) {
+        if (((mask >> t) & 1) == 0) continue;
+        int rank = r;
+        r += 1;
+        vec4 lo;
+        vec4 ld;
+        for (int i = 0; i < 4; ++i) {
+            vec4 m = SV_TET_BARY[4 * t + i];
+            lo[i] = dot(m.xyz, P0) + m.w;
+            ld[i] = dot(m.xyz, D);
+        }
+        float ta = tmin;
+        float tb = 3.0e38;
+        bool empty = false;
+        for (int i = 0; i < 4; ++i) {
+            float lim = -sv_tet_margin - lo[i];
+            if (ld[i] > 0.0) ta = max(ta, lim / ld[i]);
+            else if (ld[i] < 0.0) tb = min(tb, lim / ld[i]);
+            else if (lim > 0.0) empty = true;
+        }
+        if (empty || !(ta <= tb) || ta >= t_best) continue;
+        float b[SV_VOL_NCOEF];
+        sv_load_tet(t, rank, f, b);
+        float cc[5];
+        sv_restrict(b, lo + ta * ld, lo + tb * ld, cc);
+        for (int k = 0; k <= SV_VOL_DEGREE; ++k) cc[k] -= sv_iso_shifted;
+        float s = sv_first_root_deg(cc);
+        if (s < 0.0) continue;
+        float th = ta + s * (tb - ta);
+        if (th < t_best) {
+            t_best = th;
+            tet_best = t;
+            hit.uv = vec2(float(rank), 0.0);  // remembered for the normal below
+        }
+    }
+    if (tet_best < 0) return false;
+
+    float b[SV_VOL_NCOEF];
+    sv_load_tet(tet_best, int(hit.uv.x + 0.5), f, b);
+    vec3 P = P0 + t_best * D;
+    vec4 l;
+    for (int i = 0; i < 4; ++i) {
+        vec4 m = SV_TET_BARY[4 * tet_best + i];
+        l[i] = dot(m.xyz, P) + m.w;
+    }
+    float value;
+    vec3 g = sv_tet_gradient(b, tet_best, l, value);
+    hit.t = t_best;
+    hit.pos = ro + t_best * rd;
+    hit.normal = g * sv_inv_spacing;   // chain rule: d/dx_model = d/dx_local * (1 / spacing)
+    hit.scalar = value + sv_value_ref;
+    hit.uv = (vec2(c.xy) + P.xy - 0.5 + 0.5) / sv_cube_count.xy;
+    return true;
+}

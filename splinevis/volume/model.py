@@ -1,0 +1,261 @@
+"""VolumeSpline: a trivariate spline of volume data on the type-6 partition, in world coordinates.
+
+The model keeps only what does not depend on an isovalue: the padded data (float64), the per-cube
+coefficient bounds and their :class:`~splinevis.volume.octree.MinMaxOctree`. For an isovalue,
+:meth:`VolumeSpline.relevant` finds the cubes and tetrahedra whose BB coefficients straddle it (paper 003,
+sec. 4: octree branches with the isovalue in ``[fmin, fmax]``, then the convex-hull test per tetrahedron).
+
+Coordinates: data point ``values[k, j, i]`` sits at ``origin + (i, j, k) * spacing`` and is the centre of
+its cube, so the spline is defined on ``origin - spacing/2 .. origin + (n - 1/2) * spacing`` per axis.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..bb import simplex as bb
+from ..io.volumes import VolumeGrid
+from . import schemes as _schemes
+from .octree import MinMaxOctree
+from .partition import NUM_TETS, _bary_mats, _locate
+
+__all__ = ["VolumeSpline", "Relevant", "tet_weights", "SCHEME_DEGREE", "MIN_SAMPLES"]
+
+#: Polynomial degree of each scheme on the type-6 partition.
+SCHEME_DEGREE = {"quadratic": 2, "cubic": 3}
+
+#: Samples per axis the 27-point stencil needs (a 3 x 3 x 3 block around every cube).
+MIN_SAMPLES = 3
+
+
+def tet_weights(scheme: str) -> np.ndarray:
+    """(24, m, 27) data weights of the scheme: coefficient q of tetrahedron t of the cube at data point
+    ``(i, j, k)`` is ``sum_s W[t, q, s] * padded_data[(i, j, k) + STENCIL[s]]`` (m = 10 quadratic, 20 cubic)."""
+    if scheme not in SCHEME_DEGREE:
+        raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
+    if hasattr(_schemes, "tet_weights"):
+        return np.asarray(_schemes.tet_weights(scheme), dtype=np.float64)
+    if scheme != "quadratic":
+        raise NotImplementedError("cubic weights pending")
+    _, tmap = _schemes.domain_points()  # TEMPORARY until schemes.tet_weights lands
+    return _schemes.derive_weights()["W"][tmap]
+
+
+def _negative_mass(W: np.ndarray) -> float:
+    """Largest total negative weight of any coefficient: every coefficient (weights summing to 1) then
+    lies in ``[min - N (max - min), max + N (max - min)]`` of its 27 data values."""
+    return float(np.clip(-W, 0, None).sum(axis=-1).max())
+
+
+@dataclass(frozen=True)
+class Relevant:
+    """The cubes and tetrahedra that can hold the isosurface of one isovalue.
+
+    Attributes
+    ----------
+    isovalue : float
+    cubes : (n, 3) int64 ``(i, j, k)`` of the relevant cubes.
+    masks : (n,) int64, bit t set when tetrahedron t of the cube has coefficients on both sides of the
+        isovalue (or touching it).
+    candidates : int, cubes the octree proposed (before the per-tetrahedron test).
+    seconds : float, time taken.
+    """
+
+    isovalue: float
+    cubes: np.ndarray
+    masks: np.ndarray
+    candidates: int
+    seconds: float
+
+    @property
+    def num_tets(self) -> int:
+        return int(np.bitwise_count(self.masks).sum())
+
+
+class VolumeSpline:
+    """Quadratic or cubic spline on the type-6 partition of a volume (paper 003).
+
+    Parameters
+    ----------
+    volume : VolumeGrid, or array-like (nz, ny, nx), or anything :func:`splinevis.io.volumes.read_volume`
+        accepts (a file path, a pyvista ImageData, ...).
+    scheme : {"quadratic", "cubic"}
+        ``"quadratic"``: quadratic super spline; ``"cubic"``: cubic C1 quasi-interpolant
+        (docs/volume-schemes.md).
+    **read_options
+        Passed to ``read_volume`` (spacing, origin, scalars, ...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
+    >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic")
+    >>> float(s.evaluate([[3.25, 2.5, 1.0]])[0])  # linear data are reproduced
+    11.25
+    """
+
+    def __init__(self, volume, scheme: str = "quadratic", **read_options):
+        if scheme not in SCHEME_DEGREE:
+            raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
+        if isinstance(volume, VolumeGrid):
+            if read_options:
+                raise TypeError(f"read options {sorted(read_options)} apply to files and arrays, not to a VolumeGrid.")
+            grid = volume
+        else:
+            grid = _read(volume, read_options)
+        if min(grid.shape) < MIN_SAMPLES:
+            raise ValueError(
+                f"the {scheme} scheme needs at least {MIN_SAMPLES} samples along every axis (its 27-point stencil spans "
+                f"3 x 3 x 3 samples); {grid.source} has shape (nz, ny, nx) = {grid.shape}. Resample the data to a finer grid "
+                f"or use a baseline (marching cubes) for such small volumes.")
+        self.grid = grid
+        self.scheme = scheme
+        self.degree = SCHEME_DEGREE[scheme]
+        self.weights = tet_weights(scheme)
+        self.ncoef = self.weights.shape[1]
+        t0 = time.perf_counter()
+        self.padded = getattr(_schemes, 'pad_volume', _schemes._pad)(grid.values)
+        self._octree = None
+        self.setup_seconds = time.perf_counter() - t0
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def shape(self) -> tuple:
+        """``(nz, ny, nx)`` cubes (= data points)."""
+        return self.grid.shape
+
+    @property
+    def spacing(self) -> np.ndarray:
+        return np.asarray(self.grid.spacing, dtype=np.float64)
+
+    @property
+    def origin(self) -> np.ndarray:
+        return np.asarray(self.grid.origin, dtype=np.float64)
+
+    @property
+    def bounds(self) -> tuple:
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the spline's domain (cube faces, world)."""
+        n = np.array(self.shape[::-1], dtype=np.float64)
+        lo = self.origin - 0.5 * self.spacing
+        hi = self.origin + (n - 0.5) * self.spacing
+        return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+
+    @property
+    def value_range(self) -> tuple:
+        return self.grid.value_range
+
+    # ------------------------------------------------------------------ coefficients
+    def stencil_data(self, cubes) -> np.ndarray:
+        """(n, 27) padded data of the cubes' 27-point stencils (cubes as (n, 3) ``(i, j, k)``)."""
+        c = np.asarray(cubes, dtype=np.int64).reshape(-1, 3)
+        off = _schemes.STENCIL  # (27, 3) as (x, y, z)
+        i = c[:, None, 0] + 1 + off[None, :, 0]
+        j = c[:, None, 1] + 1 + off[None, :, 1]
+        k = c[:, None, 2] + 1 + off[None, :, 2]
+        return self.padded[k, j, i]
+
+    def cube_coefficients(self, cubes, *, chunk: int = 32768) -> np.ndarray:
+        """(n, 24, m) BB coefficients of the given cubes (float64), computed in chunks."""
+        c = np.asarray(cubes, dtype=np.int64).reshape(-1, 3)
+        W = self.weights.reshape(-1, 27).T  # (27, 24 m)
+        out = np.empty((len(c), NUM_TETS, self.ncoef))
+        for s in range(0, len(c), chunk):
+            out[s:s + chunk] = (self.stencil_data(c[s:s + chunk]) @ W).reshape(-1, NUM_TETS, self.ncoef)
+        return out
+
+    # ------------------------------------------------------------------ evaluation (float64 reference)
+    def _locate(self, points):
+        q = self.grid.to_index(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+        n = np.array(self.shape[::-1])
+        lo, hi = -0.5, n - 0.5
+        bad = ((q < lo - 1e-9) | (q > hi + 1e-9)).any(axis=1)
+        if bad.any():
+            b = int(np.argmax(bad))
+            raise ValueError(f"point {b} {np.asarray(points).reshape(-1, 3)[b].tolist()} lies outside the spline's domain "
+                             f"{tuple(round(v, 6) for v in self.bounds)} (xmin, xmax, ymin, ymax, zmin, zmax).")
+        cell = np.clip(np.floor(q + 0.5), 0, n - 1).astype(np.int64)
+        local = np.clip(q - (cell - 0.5), 0.0, 1.0)
+        t, lam = _locate(local)
+        return cell, t, lam
+
+    def evaluate(self, points, *, gradient: bool = False):
+        """Spline values (and world gradients ``(n, 3)`` if ``gradient``) at world points ``(n, 3)``."""
+        cell, t, lam = self._locate(points)
+        uc, inv = np.unique(cell, axis=0, return_inverse=True)
+        coef = self.cube_coefficients(uc)[inv.ravel(), t]  # (n, m)
+        val = bb._decasteljau(coef, self.degree, 3, lam)
+        if not gradient:
+            return val
+        g = bb.gradient(coef, d=3)
+        dlam = bb._decasteljau(g, self.degree - 1, 3, lam[:, None, :])
+        grad_local = np.einsum("ni,nij->nj", dlam, _bary_mats()[t][..., :3])
+        return val, grad_local / self.spacing
+
+    # ------------------------------------------------------------------ isovalue-independent structure
+    def cube_ranges(self) -> tuple:
+        """Per-cube ``(lo, hi)`` float32 bounds of the cube's BB coefficients (rounded outward), from the min
+        and max of its 27 data values and the scheme's negative weight mass."""
+        from scipy import ndimage
+
+        P = self.padded
+        mn = ndimage.minimum_filter(P, size=3, mode="nearest")[1:-1, 1:-1, 1:-1]
+        mx = ndimage.maximum_filter(P, size=3, mode="nearest")[1:-1, 1:-1, 1:-1]
+        N = _negative_mass(self.weights)
+        if N > 0:
+            spread = mx - mn
+            mn = mn - N * spread
+            mx = mx + N * spread
+        lo = np.nextafter(mn.astype(np.float32), np.float32(-np.inf))
+        hi = np.nextafter(mx.astype(np.float32), np.float32(np.inf))
+        return lo, hi
+
+    @property
+    def octree(self) -> MinMaxOctree:
+        """The min-max octree (built on first use; independent of the isovalue)."""
+        if self._octree is None:
+            self._octree = MinMaxOctree(*self.cube_ranges())
+        return self._octree
+
+    def relevant(self, isovalue: float, *, chunk: int = 32768) -> Relevant:
+        """Cubes and tetrahedra that can contain the isosurface ``s = isovalue`` (paper 003, sec. 4).
+
+        An isovalue outside the data's range gives an empty result (an empty scene), not an error.
+        """
+        iso = float(isovalue)
+        if not np.isfinite(iso):
+            raise ValueError(f"isovalue must be a finite number, got {isovalue!r}.")
+        t0 = time.perf_counter()
+        cand = self.octree.candidates(iso)
+        cubes, masks = [], []
+        bits = (np.int64(1) << np.arange(NUM_TETS, dtype=np.int64))
+        for s in range(0, len(cand), chunk):
+            c = cand[s:s + chunk]
+            coef = self.cube_coefficients(c)
+            lo, hi = coef.min(axis=2), coef.max(axis=2)  # (n, 24)
+            rel = (lo <= iso) & (iso <= hi)
+            m = (rel * bits).sum(axis=1)
+            keep = m != 0
+            cubes.append(c[keep])
+            masks.append(m[keep])
+        cubes = np.concatenate(cubes) if cubes else np.zeros((0, 3), np.int64)
+        masks = np.concatenate(masks) if masks else np.zeros(0, np.int64)
+        return Relevant(iso, cubes, masks, len(cand), time.perf_counter() - t0)
+
+    def __repr__(self):
+        nz, ny, nx = self.shape
+        return (f"VolumeSpline({self.scheme}, {nx}x{ny}x{nz} cubes, spacing={self.grid.spacing}, origin={self.grid.origin}, "
+                f"source={self.grid.source!r})")
+
+
+def _read(volume, options) -> VolumeGrid:
+    try:
+        from ..io.volumes import read_volume
+    except ImportError:  # pragma: no cover - readers arrive with issue 4
+        read_volume = None
+    if read_volume is not None:
+        return read_volume(volume, **options)
+    return VolumeGrid(np.asarray(volume, dtype=np.float64), **options)

@@ -1,0 +1,204 @@
+"""The GPU program of a volume isosurface (glsl/programs/isosurface.glsl): proxies, textures, uniforms.
+
+Data streams (paper 003, sec. 5.1), two encodings selectable for measurement:
+
+* ``encoding="data"`` (default): one float32 texture of the padded volume (``data - value_ref``), uploaded
+  once per volume and independent of the isovalue; the shader fetches a cube's 27 values and rebuilds the
+  BB coefficients of a tetrahedron with the scheme's averaging rules (generated
+  glsl/lib/volume_stencil_*.glsl). This is paper 003's determining-set encoding taken one step further:
+  the paper stores the 20 (quadratic) or 56 (cubic) determining coefficients per cube, which are
+  themselves averages of the data; storing the data is 1 value per cube.
+* ``encoding="coefficients"``: every BB coefficient of every relevant tetrahedron in a table (the "direct
+  approach" the paper compares with), rebuilt for every isovalue.
+
+Bounding geometry: one box per relevant cube (8 vertices, 12 triangles), with flat attributes
+``sv_cube = (i, j, k, low 12 bits of the tet mask)``, ``sv_cube_extra = (high 12 bits of the mask, row of the
+cube's first tetrahedron in the table as two 12-bit halves)``, and the
+interpolated cube-local corner coordinates ``sv_local``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._validation import check_choice, check_degree
+from ..gl.spec import ProgramSpec
+from .model import Relevant, VolumeSpline
+
+__all__ = ["Isosurface", "isosurface_program", "data_texture", "coefficient_table", "memory_report",
+           "TEXTURE_WIDTH", "TET_MARGIN"]
+
+#: Texels per row of the linear data/coefficient textures (GL_MAX_TEXTURE_SIZE of llvmpipe is 16384).
+TEXTURE_WIDTH = 8192
+#: Clip margin (barycentric units) of every tetrahedron, against cracks between neighbours: the
+#: interpolated cube-local fragment position is accurate to a few float32 ulps of 1 (~1e-7); 2^-16 leaves
+#: a factor > 100.
+TET_MARGIN = 2.0**-16
+
+_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+                    dtype=np.float64)
+_BOX_TRIS = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+                      [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]], dtype=np.int64)
+
+
+@dataclass
+class Isosurface:
+    """The isosurface ``s = isovalue`` of a :class:`VolumeSpline`, what :meth:`splinevis.Plotter.add_spline`
+    draws. ``relevant`` is computed on first use (and is all that changes with the isovalue)."""
+
+    spline: VolumeSpline
+    isovalue: float
+    _relevant: Relevant | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if not isinstance(self.spline, VolumeSpline):
+            raise TypeError(f"spline must be a VolumeSpline, got {type(self.spline).__name__}.")
+        self.isovalue = float(self.isovalue)
+        if not np.isfinite(self.isovalue):
+            raise ValueError(f"isovalue must be finite, got {self.isovalue!r}.")
+
+    @property
+    def relevant(self) -> Relevant:
+        if self._relevant is None or self._relevant.isovalue != self.isovalue:
+            self._relevant = self.spline.relevant(self.isovalue)
+        return self._relevant
+
+    @property
+    def extent(self):  # texture coordinates span the volume's x/y (Style.texture_extent)
+        b = self.spline.bounds
+        return (b[0], b[1], b[2], b[3])
+
+
+def value_reference(spline: VolumeSpline) -> float:
+    """The value subtracted from the data before float32 upload (mid-range; isovalue independent)."""
+    lo, hi = spline.value_range
+    return 0.5 * (lo + hi)
+
+
+def _linear_texture(values: np.ndarray) -> np.ndarray:
+    flat = np.asarray(values, dtype=np.float32).ravel()
+    ntex = -(-len(flat) // 4)
+    rows = max(1, -(-ntex // TEXTURE_WIDTH))
+    buf = np.zeros(rows * TEXTURE_WIDTH * 4, dtype=np.float32)
+    buf[: len(flat)] = flat
+    return buf.reshape(rows, TEXTURE_WIDTH, 4)
+
+
+def data_texture(spline: VolumeSpline) -> np.ndarray:
+    """(rows, TEXTURE_WIDTH, 4) float32: the padded volume minus :func:`value_reference`, x fastest."""
+    return _linear_texture(spline.padded - value_reference(spline))
+
+
+def coefficient_table(spline: VolumeSpline, relevant: Relevant):
+    """(texture, rows): coefficients of every relevant tetrahedron (minus the reference value), in cube order
+    then tetrahedron order; ``rows[n]`` is the table row of cube n's first relevant tetrahedron."""
+    m = spline.ncoef
+    counts = np.bitwise_count(relevant.masks).astype(np.int64)
+    rows = np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
+    out = np.empty((int(counts.sum()), m), dtype=np.float64)
+    ref = value_reference(spline)
+    chunk, pos = 16384, 0
+    for s in range(0, len(relevant.cubes), chunk):
+        coef = spline.cube_coefficients(relevant.cubes[s:s + chunk])  # (n, 24, m)
+        bits = ((relevant.masks[s:s + chunk, None] >> np.arange(24)) & 1).astype(bool)
+        sel = coef[bits]  # row-major: cube order, then tetrahedron order
+        out[pos:pos + len(sel)] = sel - ref
+        pos += len(sel)
+    return _linear_texture(out), rows
+
+
+def memory_report(spline: VolumeSpline, relevant: Relevant) -> dict:
+    """Bytes of each part for one isovalue: bounding geometry (proxy vertices, attributes, indices as VTK
+    uploads them), the data texture, the coefficient table, and the octree."""
+    n = len(relevant.cubes)
+    m = spline.ncoef
+    geometry = n * (8 * (3 * 4 + 4 * 4 + 3 * 4) + 12 * 3 * 4)  # float32 points + sv_cube + sv_local, int indices
+    return {
+        "relevant_cubes": n,
+        "relevant_tets": relevant.num_tets,
+        "geometry_bytes": geometry,
+        "data_texture_bytes": int(np.prod(spline.padded.shape)) * 4,
+        "coefficient_table_bytes": relevant.num_tets * m * 4,
+        "all_coefficients_bytes": n * 24 * m * 4,
+        "determining_set_bytes": n * {10: 20, 20: 56}[m] * 4,
+        "octree_bytes": spline.octree.nbytes,
+    }
+
+
+def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encoding: str = "data",
+                       roots: str | None = None) -> ProgramSpec:
+    """Describe the ray-cast program of an isosurface.
+
+    Parameters
+    ----------
+    model : Isosurface
+    newton_iterations : int, 1..8
+        Iterations of the Newton-type root finders (cubic, or ``roots != "analytic"``).
+    encoding : {"data", "coefficients"}
+        Where the shader gets BB coefficients from (module docstring).
+    roots : {"analytic", "bracketed", "paper"}, optional
+        Quadratic default ``"analytic"`` (stable closed form); cubic default ``"bracketed"`` (bracketed Newton
+        on convex pieces); ``"paper"``: Newton from the secure starts 0, inflection point(s), 1 with a fixed
+        iteration count (paper 003 sec. 5.3; the shared implementation adds a fourth start at 2/3).
+    """
+    if not isinstance(model, Isosurface):
+        raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")
+    spline = model.spline
+    iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
+    check_choice(encoding, "encoding", {"data", "coefficients"})
+    cubic = spline.degree == 3
+    if roots is None:
+        roots = "bracketed" if cubic else "analytic"
+    check_choice(roots, "roots", {"analytic", "bracketed", "paper"})
+    if roots == "analytic" and cubic:
+        raise ValueError("roots='analytic' is the closed form for quadratics; for the cubic scheme use "
+                         "'bracketed' (default) or 'paper'.")
+    rel = model.relevant
+    n = len(rel.cubes)
+    sp = spline.spacing
+    corners = (rel.cubes[:, None, :] - 0.5 + _CORNERS[None]) * sp  # model frame: origin at data point 0
+    points = corners.reshape(-1, 3)
+    tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
+    # Integers above 2^16 lose low bits on their way through VTK's vertex attributes here (measured: the
+    # low 7 bits of a 24-bit mask vanished), so masks and rows travel as 12-bit halves.
+    cube_attr = np.repeat(np.column_stack([rel.cubes, rel.masks & 4095]).astype(np.float64), 8, axis=0)
+    mask_hi = rel.masks >> 12
+    local = np.tile(_CORNERS, (n, 1))
+    ref = value_reference(spline)
+    textures, attributes = {}, {"sv_cube": cube_attr}
+    extra = np.zeros((n, 3))
+    extra[:, 0] = mask_hi
+    if encoding == "data":
+        textures["sv_volume_data"] = data_texture(spline)
+    else:
+        table, rows = coefficient_table(spline, rel)
+        textures["sv_volume_coef"] = table
+        extra[:, 1] = rows >> 12
+        extra[:, 2] = rows & 4095
+    attributes["sv_cube_extra"] = np.repeat(extra, 8, axis=0)
+    nz, ny, nx = spline.shape
+    return ProgramSpec(
+        name="isosurface",
+        entry="programs/isosurface.glsl",
+        points=points,
+        triangles=tris,
+        offset=tuple(spline.origin),
+        defines={"SV_VOLUME_CUBIC": cubic, "SV_VOLUME_TABLE": encoding == "coefficients",
+                 "SV_ROOTS_PAPER_NEWTON": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
+        uniforms={
+            "sv_inv_spacing": tuple(1.0 / sp),
+            "sv_iso_shifted": model.isovalue - ref,
+            "sv_value_ref": ref,
+            "sv_newton_iterations": iterations,
+            "sv_tet_margin": TET_MARGIN,
+            "sv_tex_width": TEXTURE_WIDTH,
+            "sv_padded_dims": (float(nx + 2), float(ny + 2), float(nz + 2)),
+            "sv_cube_count": (float(nx), float(ny), float(nz)),
+            "sv_scalar_range": spline.value_range,
+        },
+        textures=textures,
+        attributes=attributes,
+        varyings={"sv_local": local},
+    )
