@@ -1,10 +1,30 @@
-"""Trivariate splines of volume data on the type-6 tetrahedral partition (issue 4 groundwork).
+"""Trivariate splines of volume data on the type-6 tetrahedral partition (issue 4; paper 003, Kalbe and
+Zeilfelder 2008): the quadratic super spline, the cubic C1 spline (Sorokina-Zeilfelder), the trilinear
+baseline, and an approximation study.
 
-See docs/volume-schemes.md for conventions, the derivation and what is verified.
+See docs/volume-schemes.md for conventions, the derivations and what is verified.
 """
 
+from .cubic import cubic_c1_spline
 from .partition import NUM_TETS, barycentric, barycentric_matrices, locate, type6_tetrahedra
-from .schemes import derive_weights, domain_points, edge_points, evaluate, inner_face_conditions, quadratic_super_spline
+from .schemes import (
+    SCHEMES,
+    STENCIL,
+    cube_coefficients,
+    derive_weights,
+    domain_points,
+    edge_points,
+    evaluate,
+    evaluate_volume,
+    inner_face_conditions,
+    pad_volume,
+    quadratic_super_spline,
+    spline_coefficients,
+    tet_weights,
+)
+from .trilinear import trilinear_interpolate
 
 __all__ = ["NUM_TETS", "type6_tetrahedra", "locate", "barycentric", "barycentric_matrices", "quadratic_super_spline",
-           "evaluate", "derive_weights", "domain_points", "edge_points", "inner_face_conditions"]
+           "evaluate", "derive_weights", "domain_points", "edge_points", "inner_face_conditions", "SCHEMES", "STENCIL",
+           "pad_volume", "tet_weights", "spline_coefficients", "cube_coefficients", "evaluate_volume",
+           "cubic_c1_spline", "trilinear_interpolate"]

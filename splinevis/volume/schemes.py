@@ -1,5 +1,8 @@
 """Quadratic super spline of volume data on the type-6 partition (Roessl et al. 2004; Nuernberger et
-al., CAGD 22 (2005); used on the GPU by Kalbe and Zeilfelder, paper 003). See docs/volume-schemes.md.
+al., CAGD 22 (2005); used on the GPU by Kalbe and Zeilfelder, paper 003), and the interface shared with
+the cubic C1 scheme (:mod:`splinevis.volume.cubic`) in the format the GPU program reads: ``STENCIL``,
+:func:`pad_volume`, :func:`tet_weights`, :func:`spline_coefficients`, :func:`cube_coefficients`,
+:func:`evaluate`, :func:`evaluate_volume`. See docs/volume-schemes.md.
 
 Conventions
 -----------
@@ -48,7 +51,8 @@ from ..bb import simplex as bb
 from .partition import NUM_TETS, _bary_mats, _locate, _tets
 
 __all__ = ["domain_points", "edge_points", "inner_face_conditions", "derive_weights",
-           "quadratic_super_spline", "evaluate", "NUM_DOMAIN_POINTS"]
+           "quadratic_super_spline", "evaluate", "NUM_DOMAIN_POINTS", "STENCIL", "SCHEMES", "pad_volume",
+           "tet_weights", "spline_coefficients", "cube_coefficients", "evaluate_volume"]
 
 #: Distinct quadratic domain points of one type-6 cube.
 NUM_DOMAIN_POINTS = 65
@@ -309,19 +313,40 @@ def derive_weights() -> dict:
             "hard_residual": hard_res}
 
 
-def _check_volume(volume):
+# ----------------------------------------------------------------------------------------------------
+# generic interface for both schemes (the format the GPU program reads)
+# ----------------------------------------------------------------------------------------------------
+
+#: Names of the spline schemes of this package: degree 2 (65 domain points per cube, C0/C1 as documented
+#: above) and degree 3 (:mod:`splinevis.volume.cubic`, C1 everywhere).
+SCHEMES = ("quadratic", "cubic")
+_NCOEF = {"quadratic": 10, "cubic": 20}
+_DEGREE_OF_M = {10: 2, 20: 3}
+
+
+def _check_scheme(scheme):
+    if not isinstance(scheme, str) or scheme not in SCHEMES:
+        raise ValueError(f"scheme {scheme!r} is not known; choose one of: 'quadratic' (quadratic super spline, 10 "
+                         f"coefficients per tetrahedron) or 'cubic' (cubic C1 spline, 20 coefficients).")
+    return scheme
+
+
+def _check_volume(volume, what="the 27-point stencil of the spline schemes"):
     vol = as_float64_array(volume, "volume", finite=False)
     if vol.ndim != 3:
         raise ValueError(f"volume must be a 3-D array of shape (nz, ny, nx) with volume[k, j, i] the value at "
                          f"(x, y, z) = (i, j, k); got {vol.ndim}-D shape {vol.shape}.")
     if min(vol.shape) < 2:
-        raise ValueError(f"volume must have at least 2 samples along every axis (linear extrapolation at the "
-                         f"boundary needs two); got shape {vol.shape}.")
+        ax = "zyx"[int(np.argmin(vol.shape))]
+        raise ValueError(f"volume must have at least 2 samples along every axis ({what} reads one neighbour on each "
+                         f"side, and the boundary layer is extrapolated linearly from two samples); got shape "
+                         f"{vol.shape} with {min(vol.shape)} along {ax}. Resample or pad the data to >= 2 per axis.")
     bad = ~np.isfinite(vol)
     if bad.any():
         k, j, i = (int(v) for v in np.argwhere(bad)[0])
         raise ValueError(f"volume must be finite; found {int(bad.sum())} non-finite value(s), the first, "
-                         f"{float(vol[k, j, i])!r}, at voxel [k, j, i] = [{k}, {j}, {i}] (x={i}, y={j}, z={k}).")
+                         f"{float(vol[k, j, i])!r}, at voxel [k, j, i] = [{k}, {j}, {i}] (x={i}, y={j}, z={k}). "
+                         f"Replace them (e.g. by a background value) before building a spline.")
     return vol
 
 
@@ -335,6 +360,13 @@ def _pad(vol):
     return p
 
 
+def pad_volume(volume) -> np.ndarray:
+    """The volume with one layer of linear extrapolation on every side (``f[-1] = 2 f[0] - f[1]``, axis by
+    axis, so edges and corners too): shape ``(nz + 2, ny + 2, nx + 2)``; ``padded[k + 1, j + 1, i + 1] =
+    volume[k, j, i]``. Linear data stay linear. Every axis needs >= 2 samples."""
+    return _pad(_check_volume(volume))
+
+
 def _stencil_data(vol):
     """(nz, ny, nx, 27) data of every cube's 27-point stencil (padded volume)."""
     P = _pad(vol)
@@ -342,8 +374,182 @@ def _stencil_data(vol):
     return np.stack([P[1 + oz:1 + oz + nz, 1 + oy:1 + oy + ny, 1 + ox:1 + ox + nx] for ox, oy, oz in STENCIL], axis=-1)
 
 
+def _point_weights(scheme):
+    """(number of domain points, 27) weights and the (24, m) tetrahedron map of a scheme."""
+    if scheme == "quadratic":
+        return _weights()[0], _domain()[1]
+    from . import cubic  # noqa: PLC0415  (cubic imports this module)
+    return cubic._weights()[0], cubic._domain()[1]
+
+
+@functools.lru_cache(maxsize=None)
+def _tet_weights(scheme):
+    W, tmap = _point_weights(scheme)
+    out = W[tmap]
+    out.setflags(write=False)
+    return out
+
+
+def tet_weights(scheme: str) -> np.ndarray:
+    """Data weights of every BB coefficient, the format of the GPU program.
+
+    Parameters
+    ----------
+    scheme : {"quadratic", "cubic"}
+
+    Returns
+    -------
+    (24, m, 27) float64 ndarray, m = 10 (quadratic) or 20 (cubic)
+        Coefficient ``q`` (``multi_indices(m == 10 and 2 or 3, 3)`` order w.r.t. ``[vQ, wF, u, u']``) of
+        tetrahedron ``t`` of the cube whose data point is ``(i, j, k)`` equals
+        ``sum_s W[t, q, s] * padded[(i, j, k) + STENCIL[s]]`` with ``padded`` the volume padded by
+        :func:`pad_volume` (index ``(x, y, z)`` reads ``padded[z + 1, y + 1, x + 1]``). The weights are
+        multiples of 1/16 (quadratic, exact in float64) resp. 1/192 (cubic, rounded to float64),
+        nonnegative, and sum to 1 per coefficient.
+    """
+    return _tet_weights(_check_scheme(scheme)).copy()
+
+
+def spline_coefficients(volume, scheme: str) -> np.ndarray:
+    """BB coefficients of every cube, vectorized.
+
+    Parameters
+    ----------
+    volume : (nz, ny, nx) array_like, finite, every axis >= 2
+        ``volume[k, j, i]`` = f at index-space point (x, y, z) = (i, j, k).
+    scheme : {"quadratic", "cubic"}
+
+    Returns
+    -------
+    (nz, ny, nx, 24, m) float64 ndarray, m = 10 or 20
+        Needs ``nz * ny * nx * 24 * m * 8`` bytes (2.6 GB for a cubic 256^3 volume): for big volumes use
+        :func:`cube_coefficients` on the cubes you need.
+    """
+    scheme = _check_scheme(scheme)
+    vol = _check_volume(volume)
+    W, tmap = _point_weights(scheme)
+    return (_stencil_data(vol) @ W.T)[..., tmap]
+
+
+def _check_cubes(cubes, shape):
+    c = np.asarray(cubes)
+    if c.ndim != 2 or c.shape[1] != 3 or not (np.issubdtype(c.dtype, np.integer) or c.size == 0):
+        raise ValueError(f"cubes must be an (n, 3) integer array of cube indices (i, j, k); got shape {c.shape}, "
+                         f"dtype {c.dtype}.")
+    c = c.astype(np.int64)
+    nz, ny, nx = shape
+    bad = (c < 0) | (c >= np.array([nx, ny, nz]))
+    if bad.any():
+        r = int(np.argwhere(bad.any(axis=1))[0, 0])
+        raise ValueError(f"cubes[{r}] = {c[r].tolist()} is outside the volume: (i, j, k) needs 0 <= i < nx={nx}, "
+                         f"0 <= j < ny={ny}, 0 <= k < nz={nz}.")
+    return c
+
+
+def cube_coefficients(volume, cubes, scheme: str) -> np.ndarray:
+    """BB coefficients of selected cubes only (for volumes whose full coefficient array does not fit).
+
+    Parameters
+    ----------
+    volume : (nz, ny, nx) array_like
+    cubes : (n, 3) int array_like
+        Cube indices ``(i, j, k)`` (= the data point at the cube's centre).
+    scheme : {"quadratic", "cubic"}
+
+    Returns
+    -------
+    (n, 24, m) float64 ndarray, equal to ``spline_coefficients(volume, scheme)[k, j, i]`` row by row.
+    """
+    scheme = _check_scheme(scheme)
+    vol = _check_volume(volume)
+    c = _check_cubes(cubes, vol.shape)
+    return _cube_coefficients(_pad(vol), c, scheme)
+
+
+def _cube_coefficients(padded, c, scheme):
+    W = _tet_weights(scheme)
+    idx = c[:, None, :] + STENCIL[None, :, :] + 1  # (n, 27, 3) as (x, y, z) into padded
+    data = padded[idx[..., 2], idx[..., 1], idx[..., 0]]  # (n, 27)
+    return np.einsum("ns,tqs->ntq", data, W)
+
+
+def _check_coef(coef):
+    c = as_float64_array(coef, "coef")
+    if c.ndim != 5 or c.shape[3] != NUM_TETS or c.shape[4] not in _DEGREE_OF_M:
+        raise ValueError(f"coef must have shape (nz, ny, nx, 24, 10) (quadratic) or (nz, ny, nx, 24, 20) (cubic), "
+                         f"as returned by spline_coefficients; got {c.shape}.")
+    return c
+
+
+def _check_points(p, shape, tol):
+    nz, ny, nx = shape
+    hi = np.array([nx, ny, nz], dtype=np.float64) - 0.5
+    out = (p < -0.5 - tol) | (p > hi + tol)
+    if out.any():
+        idx = tuple(int(v) for v in np.argwhere(out.any(axis=-1))[0]) if p.ndim > 1 else ()
+        raise ValueError(f"points must lie in the spline domain [-1/2, n - 1/2] per axis (x: nx={nx}, y: ny={ny}, "
+                         f"z: nz={nz}); the point at index {idx} is {p[idx].tolist()}.")
+    cell = np.clip(np.floor(p + 0.5), 0, hi - 0.5).astype(np.int64)
+    local = np.clip(p - (cell - 0.5), 0.0, 1.0)
+    return cell, local
+
+
+def _eval_patch(cc, t, lam, gradient):
+    """Value (and gradient w.r.t. the local = index-space coordinates) of patches cc (..., m) of
+    tetrahedra t at barycentric lam."""
+    n = _DEGREE_OF_M[cc.shape[-1]]
+    val = bb._decasteljau(cc, n, 3, lam)
+    if not gradient:
+        return val
+    g = bb.gradient(cc, d=3)  # (..., 4, m'): d p / d lam_i as degree n-1 coefficients
+    dlam = bb._decasteljau(g, n - 1, 3, lam[..., None, :])  # (..., 4)
+    grad = np.einsum("...i,...ij->...j", dlam, _bary_mats()[t][..., :3])
+    return val, grad
+
+
+def evaluate(coef, points, *, gradient: bool = False, tol: float = 1e-9):
+    """Evaluate a quadratic or cubic spline (and optionally its gradient) at index-space points.
+
+    Parameters
+    ----------
+    coef : (nz, ny, nx, 24, m) array_like, m = 10 (degree 2) or 20 (degree 3)
+        From :func:`spline_coefficients` (or :func:`quadratic_super_spline`).
+    points : (..., 3) array_like
+        Points ``(x, y, z)`` in ``[-1/2, nx - 1/2] x [-1/2, ny - 1/2] x [-1/2, nz - 1/2]`` (up to tol).
+    gradient : bool
+        Also return the gradient ``(..., 3)`` (d/dx, d/dy, d/dz) of the patch containing the point.
+
+    Returns
+    -------
+    values (...), or (values, gradients (..., 3)).
+    """
+    c = _check_coef(coef)
+    p = as_float64_array(points, "points", shape_tail=(3,))
+    cell, local = _check_points(p, c.shape[:3], tol)
+    t, lam = _locate(local)
+    cc = c[cell[..., 2], cell[..., 1], cell[..., 0], t]  # (..., m)
+    return _eval_patch(cc, t, lam, gradient)
+
+
+def evaluate_volume(volume, points, scheme: str, *, gradient: bool = False, tol: float = 1e-9):
+    """Evaluate the spline of ``volume`` at ``points`` building only the cubes that contain them
+    (memory O(points), any volume size); same result as ``evaluate(spline_coefficients(volume, scheme),
+    points)``."""
+    scheme = _check_scheme(scheme)
+    vol = _check_volume(volume)
+    p = as_float64_array(points, "points", shape_tail=(3,))
+    cell, local = _check_points(p, vol.shape, tol)
+    flat = cell.reshape(-1, 3)
+    uniq, inv = np.unique(flat, axis=0, return_inverse=True)
+    coefs = _cube_coefficients(_pad(vol), uniq, scheme)  # (u, 24, m)
+    t, lam = _locate(local)
+    cc = coefs[inv.reshape(cell.shape[:-1]), t]
+    return _eval_patch(cc, t, lam, gradient)
+
+
 def quadratic_super_spline(volume) -> np.ndarray:
-    """BB coefficients of the quadratic super spline of ``volume``.
+    """BB coefficients of the quadratic super spline of ``volume``: ``spline_coefficients(volume,
+    "quadratic")``.
 
     Parameters
     ----------
@@ -356,53 +562,4 @@ def quadratic_super_spline(volume) -> np.ndarray:
         Cube ``[k, j, i]`` is centred at the data point (i, j, k); patch t is tetrahedron t of
         :func:`splinevis.volume.partition.type6_tetrahedra`, coefficients in ``multi_indices(2, 3)`` order.
     """
-    vol = _check_volume(volume)
-    W = _weights()[0]
-    _, tmap, _ = _domain()
-    allc = _stencil_data(vol) @ W.T  # (nz, ny, nx, 65)
-    return allc[..., tmap]
-
-
-def _check_coef(coef):
-    c = as_float64_array(coef, "coef")
-    if c.ndim != 5 or c.shape[3:] != (NUM_TETS, 10):
-        raise ValueError(f"coef must have shape (nz, ny, nx, 24, 10); got {c.shape}.")
-    return c
-
-
-def evaluate(coef, points, *, gradient: bool = False, tol: float = 1e-9):
-    """Evaluate the spline (and optionally its gradient) at index-space points.
-
-    Parameters
-    ----------
-    coef : (nz, ny, nx, 24, 10) array_like
-        From :func:`quadratic_super_spline`.
-    points : (..., 3) array_like
-        Points ``(x, y, z)`` in ``[-1/2, nx - 1/2] x [-1/2, ny - 1/2] x [-1/2, nz - 1/2]`` (up to tol).
-    gradient : bool
-        Also return the gradient ``(..., 3)`` (d/dx, d/dy, d/dz) of the patch containing the point.
-
-    Returns
-    -------
-    values (...), or (values, gradients (..., 3)).
-    """
-    c = _check_coef(coef)
-    p = as_float64_array(points, "points", shape_tail=(3,))
-    nz, ny, nx = c.shape[:3]
-    hi = np.array([nx, ny, nz], dtype=np.float64) - 0.5
-    out = (p < -0.5 - tol) | (p > hi + tol)
-    if out.any():
-        idx = tuple(int(v) for v in np.argwhere(out.any(axis=-1))[0]) if p.ndim > 1 else ()
-        raise ValueError(f"points must lie in the spline domain [-1/2, n - 1/2] per axis (x: nx={nx}, y: ny={ny}, "
-                         f"z: nz={nz}); the point at index {idx} is {p[idx].tolist()}.")
-    cell = np.clip(np.floor(p + 0.5), 0, hi - 0.5).astype(np.int64)
-    local = np.clip(p - (cell - 0.5), 0.0, 1.0)
-    t, lam = _locate(local)
-    cc = c[cell[..., 2], cell[..., 1], cell[..., 0], t]  # (..., 10)
-    val = bb._decasteljau(cc, 2, 3, lam)
-    if not gradient:
-        return val
-    g = bb.gradient(cc, d=3)  # (..., 4, 4): d p / d lam_i as degree-1 coefficients
-    dlam = bb._decasteljau(g, 1, 3, lam[..., None, :])  # (..., 4)
-    grad = np.einsum("...i,...ij->...j", dlam, _bary_mats()[t][..., :3])
-    return val, grad
+    return spline_coefficients(volume, "quadratic")

@@ -1,0 +1,426 @@
+"""splinevis.io.read_volume: every format round-trips exact values and geometry; bad input fails clearly."""
+
+import doctest
+import gzip
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+import splinevis.io.volumes as volumes_module
+from datasets_synthetic.volumes import WRITE_FORMATS, write_volume
+from splinevis.io import VolumeGrid, read_volume
+
+DTYPES = ["uint8", "uint16", "int16", "int32", "float32", "float64"]
+HUGE = dict(spacing=(1e3, 0.1, 7.0 / 9.0), origin=(1e6 + 0.1, -123456.789012345, 10.0 / 3.0))
+
+
+def values_of(dtype, shape=(3, 4, 5), seed=0):
+    """Random samples covering the dtype's range (float: wide exponents), shape (nz, ny, nx)."""
+    rng = np.random.default_rng(seed)
+    dt = np.dtype(dtype)
+    if dt.kind in "iu":
+        info = np.iinfo(dt)
+        a = rng.integers(info.min, info.max, size=shape, endpoint=True, dtype=dt)
+        a.flat[0], a.flat[1] = info.min, info.max
+        return a
+    return (rng.standard_normal(shape) * 10.0 ** rng.integers(-30, 30, size=shape)).astype(dt)
+
+
+def grid_of(dtype, **geometry):
+    return VolumeGrid(values_of(dtype), dtype=dtype, scalars="density", **(geometry or HUGE))
+
+
+def test_docstring_examples_run():
+    result = doctest.testmod(volumes_module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
+
+
+# ---- round trips ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("dtype", DTYPES)
+@pytest.mark.parametrize("ext", [e for e in WRITE_FORMATS if e != ".slc"])
+@pytest.mark.parametrize("byteorder", ["little", "big"])
+def test_round_trip_every_format_and_dtype_exact(tmp_path, ext, dtype, byteorder):
+    g = grid_of(dtype)
+    kwargs = write_volume(g, tmp_path / f"v{ext}", byteorder=byteorder)
+    back = read_volume(tmp_path / f"v{ext}", **kwargs)
+    assert back.dtype == dtype and back.values.dtype == np.float64
+    assert np.array_equal(back.values, g.values)  # float32 and int32 are exact in float64
+    assert back.spacing == g.spacing and back.origin == g.origin  # huge origin, awkward spacing: bit-exact
+    assert back.source == str(tmp_path / f"v{ext}")
+
+
+def test_round_trip_compressed_nrrd_and_mha(tmp_path):
+    g = grid_of("int16")
+    for ext in (".nrrd", ".mha", ".nhdr", ".mhd"):
+        write_volume(g, tmp_path / f"c{ext}", compress=True)
+        back = read_volume(tmp_path / f"c{ext}")
+        assert np.array_equal(back.values, g.values) and back.origin == g.origin, ext
+
+
+def test_slc_round_trip_uint8_and_origin_keyword(tmp_path):
+    g = VolumeGrid(values_of("uint8"), spacing=(0.5, 2.0, 1.0 / 3.0), origin=(7.0, 8.0, 9.0), dtype="uint8")
+    kwargs = write_volume(g, tmp_path / "v.slc")
+    assert kwargs == {"origin": (7.0, 8.0, 9.0)}  # SLC has no origin
+    back = read_volume(tmp_path / "v.slc", **kwargs)
+    assert np.array_equal(back.values, g.values) and back.spacing == g.spacing and back.origin == g.origin
+    assert read_volume(tmp_path / "v.slc").origin == (0.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match="SLC holds 8-bit samples"):
+        write_volume(grid_of("uint16"), tmp_path / "w.slc")
+
+
+def test_legacy_vtk_written_by_vtk_rounds_geometry_but_ours_does_not(tmp_path):
+    g = grid_of("float32")
+    g.to_pyvista().save(tmp_path / "vtk_own.vtk")  # VTK's writer: 6 significant digits
+    theirs = read_volume(tmp_path / "vtk_own.vtk")
+    assert theirs.origin[0] == 1e6 and theirs.origin != g.origin
+    write_volume(g, tmp_path / "ours.vtk")
+    assert read_volume(tmp_path / "ours.vtk").origin == g.origin
+
+
+def test_layout_values_kji_at_origin_plus_ijk_spacing(tmp_path):
+    nz, ny, nx = 3, 4, 5
+    k, j, i = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
+    a = (100 * k + 10 * j + i).astype(np.int32)
+    g = read_volume(a, spacing=(0.5, 2.0, 3.0), origin=(1.0, 2.0, 3.0))
+    assert g.values[2, 1, 4] == 214 and g.to_world([4, 1, 2]).tolist() == [3.0, 4.0, 9.0]
+    img = g.to_pyvista()
+    p = img.points[np.argmax(img.point_data["values"] == 214)]
+    assert p.tolist() == [3.0, 4.0, 9.0]  # VTK agrees on where the sample lies
+    write_volume(g, tmp_path / "a.nrrd")
+    assert np.array_equal(read_volume(tmp_path / "a.nrrd").values, a)
+
+
+# ---- numpy, pyvista ----------------------------------------------------------------------------------
+def test_numpy_defaults_copy_and_scalar_spacing():
+    a = np.arange(24.0).reshape(2, 3, 4)
+    g = read_volume(a)
+    assert g.spacing == (1.0, 1.0, 1.0) and g.origin == (0.0, 0.0, 0.0) and g.source == "numpy array"
+    assert g.dtype == "float64" and not g.values.flags.writeable
+    a[0, 0, 0] = 99
+    assert g.values[0, 0, 0] == 0
+    assert read_volume(np.zeros((2, 2, 2)), spacing=0.25).spacing == (0.25, 0.25, 0.25)
+
+
+def test_pyvista_and_vtk_image_with_anisotropic_spacing():
+    img = pv.ImageData(dimensions=(5, 4, 3), spacing=(0.5, 2.0, 3.0), origin=(1e6, -2.0, 5.0))
+    a = values_of("uint16", (3, 4, 5))
+    img.point_data["ct"] = a.ravel()
+    for src in (img, img.copy()):
+        g = read_volume(src)
+        assert np.array_equal(g.values, a) and g.spacing == (0.5, 2.0, 3.0) and g.origin == (1e6, -2.0, 5.0)
+        assert g.scalars == "ct" and g.dtype == "uint16"
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+
+    raw = vtkImageData()
+    raw.DeepCopy(img)
+    g = read_volume(raw)
+    assert np.array_equal(g.values, a) and g.source == "pyvista.ImageData"
+
+
+def test_image_extent_not_starting_at_zero():
+    img = pv.ImageData(dimensions=(3, 3, 3), spacing=(2.0, 1.0, 1.0), origin=(10.0, 0.0, 0.0))
+    img.extent = (2, 4, 0, 2, 1, 3)
+    img.point_data["v"] = np.arange(27.0)
+    g = read_volume(img)
+    assert g.origin == (14.0, 0.0, 1.0) and g.origin == tuple(img.points[0])
+
+
+def test_cell_data_are_samples_at_voxel_centres():
+    img = pv.ImageData(dimensions=(4, 3, 3), spacing=(1.0, 2.0, 4.0), origin=(0.0, 0.0, 0.0))
+    img.cell_data["label"] = np.arange(12, dtype=np.uint8)
+    g = read_volume(img)
+    assert g.shape == (2, 2, 3) and g.origin == (0.5, 1.0, 2.0) and g.spacing == (1.0, 2.0, 4.0)
+    centres = img.cell_centers().points
+    assert np.array_equal(g.to_world([2, 1, 1]), centres[11]) and g.values[1, 1, 2] == 11
+
+
+def test_several_arrays_need_scalars_and_missing_name_lists_them():
+    img = pv.ImageData(dimensions=(3, 3, 3))
+    img.point_data["a"] = np.zeros(27)
+    img.point_data["b"] = np.ones(27)
+    img.cell_data["c"] = np.ones(8)
+    with pytest.raises(ValueError, match=r"3 data arrays, which one\? Pass scalars= with one of: 'a' \(point data\), "
+                                         r"'b' \(point data\), 'c' \(cell data\)"):
+        read_volume(img)
+    assert read_volume(img, scalars="b").value_range == (1.0, 1.0)
+    assert read_volume(img, scalars="c").shape == (2, 2, 2)
+    with pytest.raises(ValueError, match=r"no data array named 'd'; arrays: 'a' \(point data\)"):
+        read_volume(img, scalars="d")
+
+
+def test_scalars_selection_in_a_vti_file(tmp_path):
+    img = pv.ImageData(dimensions=(3, 3, 3))
+    img.point_data["density"] = np.arange(27, dtype=np.int16)
+    img.point_data["temperature"] = np.arange(27, dtype=np.float32) / 4
+    img.save(tmp_path / "two.vti")
+    g = read_volume(tmp_path / "two.vti", scalars="temperature")
+    assert g.scalars == "temperature" and g.dtype == "float32" and g.values[2, 2, 2] == 26 / 4
+    with pytest.raises(ValueError, match=r"two\.vti: 2 data arrays.*'density'.*'temperature'"):
+        read_volume(tmp_path / "two.vti")
+
+
+def test_multi_component_error_pick_and_magnitude(tmp_path):
+    img = pv.ImageData(dimensions=(3, 3, 3))
+    vec = np.column_stack([np.full(27, 3.0), np.full(27, 4.0), np.zeros(27)])
+    img.point_data["velocity"] = vec
+    with pytest.raises(ValueError, match=r"'velocity' has 3 components per sample; a volume needs one\. Pass "
+                                         r"component=0\.\.2 to pick one or component='magnitude'"):
+        read_volume(img)
+    assert read_volume(img, component=1).value_range == (4.0, 4.0)
+    assert read_volume(img, component="magnitude").value_range == (5.0, 5.0)
+    with pytest.raises(ValueError, match="out of range"):
+        read_volume(img, component=3)
+    with pytest.raises(ValueError, match="component 'norm' is not known"):
+        read_volume(img, component="norm")
+    a4 = np.stack([np.zeros((2, 2, 2)), np.full((2, 2, 2), 2.0)], axis=-1)
+    assert read_volume(a4, component=1).value_range == (2.0, 2.0)
+    # a 4-D NRRD: vector axis first, as NRRD stores vector fields
+    hdr = ("NRRD0004\ntype: float\ndimension: 4\nsizes: 2 3 3 3\nkinds: vector domain domain domain\n"
+           "encoding: raw\nendian: little\n\n")
+    (tmp_path / "vec.nrrd").write_bytes(hdr.encode() + np.tile([3.0, 4.0], 27).astype("<f4").tobytes())
+    with pytest.raises(ValueError, match="vector axis' has 2 components"):
+        read_volume(tmp_path / "vec.nrrd")
+    assert read_volume(tmp_path / "vec.nrrd", component="magnitude").value_range == (5.0, 5.0)
+
+
+# ---- direction matrices and flips ---------------------------------------------------------------------
+@pytest.mark.parametrize("ext", [".vti", ".mha", ".nrrd", None])
+def test_axis_flips_are_normalised_to_the_same_picture(tmp_path, ext):
+    a = values_of("int16", (3, 4, 5))
+    D = np.diag([-1.0, 1.0, -1.0])
+    spacing, origin = (0.5, 2.0, 3.0), (10.0, 20.0, 30.0)
+    if ext is None:
+        img = pv.ImageData(dimensions=(5, 4, 3), spacing=spacing, origin=origin)
+        img.direction_matrix = D
+        img.point_data["v"] = a.ravel()
+        src = img
+    else:
+        write_volume(VolumeGrid(a, spacing=spacing, origin=origin, dtype="int16"), tmp_path / f"f{ext}",
+                     direction=D)
+        src = tmp_path / f"f{ext}"
+    g = read_volume(src)
+    assert g.spacing == spacing
+    assert g.origin == (10.0 - 4 * 0.5, 20.0, 30.0 - 2 * 3.0)
+    assert np.array_equal(g.values, a[::-1, :, ::-1])
+    # the same world points carry the same values as VTK places them
+    img = pv.ImageData(dimensions=(5, 4, 3), spacing=spacing, origin=origin)
+    img.direction_matrix = D
+    stored_world = img.points.reshape(3, 4, 5, 3)
+    kji = np.rint((stored_world - g.origin) / g.spacing).astype(int)
+    assert np.array_equal(g.values[kji[..., 2], kji[..., 1], kji[..., 0]], a)
+
+
+@pytest.mark.parametrize("ext", [".vti", ".mha", ".nrrd", None])
+def test_rotated_or_permuted_direction_is_refused(tmp_path, ext):
+    c, s = np.cos(0.3), np.sin(0.3)
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    perm = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    for D, what in ((rot, r"is not axis-aligned \(a rotation or shear\)"), (perm, "permutes the axes")):
+        g = VolumeGrid(np.zeros((3, 3, 3)))
+        if ext is None:
+            src = g.to_pyvista()
+            src.direction_matrix = D
+        else:
+            src = tmp_path / f"r{ext}"
+            write_volume(g, src, direction=D)
+        with pytest.raises(ValueError, match=what + r"; only axis-aligned grids \(the identity up to axis flips"):
+            read_volume(src)
+
+
+def test_nrrd_tiny_axis_vector_of_few_samples_is_not_taken_for_components(tmp_path):
+    # VTK's reader would make the 4-sample x axis a 4-component vector; ours keeps 3 spatial axes
+    a = np.arange(2 * 3 * 4, dtype="<u2").reshape(2, 3, 4)
+    hdr = ("NRRD0004\ntype: uint16\ndimension: 3\nsizes: 4 3 2\nspacings: 0.5 -2 3\naxis mins: 1 2 3\n"
+           "encoding: raw\nendian: little\n\n")
+    (tmp_path / "s.nrrd").write_bytes(hdr.encode() + a.tobytes())
+    g = read_volume(tmp_path / "s.nrrd")
+    assert g.shape == (2, 3, 4) and g.spacing == (0.5, 2.0, 3.0)
+    assert g.origin == (1.0, 2.0 - 2 * 2.0, 3.0) and np.array_equal(g.values, a[:, ::-1, :])
+
+
+def test_nrrd_ascii_and_byte_skip(tmp_path):
+    a = np.arange(8, dtype=np.float64).reshape(2, 2, 2) / 8
+    hdr = "NRRD0004\ntype: double\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\n\n"
+    (tmp_path / "t.nrrd").write_text(hdr + " ".join(repr(float(v)) for v in a.ravel()))
+    assert np.array_equal(read_volume(tmp_path / "t.nrrd").values, a)
+    hdr = "NRRD0004\ntype: int16\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: big\nbyte skip: -1\n\n"
+    (tmp_path / "b.nrrd").write_bytes(hdr.encode() + b"junk" + a.astype(">i2").tobytes())
+    assert np.array_equal(read_volume(tmp_path / "b.nrrd").values, a.astype(np.int16))
+    hdr = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\nbyte skip: 2\n\n"
+    (tmp_path / "g.nrrd").write_bytes(hdr.encode() + gzip.compress(b"xx" + bytes(range(8))))
+    assert read_volume(tmp_path / "g.nrrd").values.ravel().tolist() == list(range(8))
+
+
+# ---- grids that are not uniform image data -------------------------------------------------------------
+def test_uniform_rectilinear_accepted_non_uniform_refused(tmp_path):
+    x, y, z = np.arange(4) * 0.5 + 1e6, np.arange(3) * 2.0, np.array([0.0, 3.0, 6.0])
+    rg = pv.RectilinearGrid(x, y, z)
+    rg.point_data["v"] = np.arange(36.0)
+    g = read_volume(rg)
+    assert g.spacing == (0.5, 2.0, 3.0) and g.origin == (1e6, 0.0, 0.0) and g.values[2, 2, 3] == 35
+    rg2 = pv.RectilinearGrid(x, y, np.array([0.0, 1.0, 3.0]))
+    rg2.point_data["v"] = np.arange(36.0)
+    rg2.save(tmp_path / "nu.vtr")
+    with pytest.raises(ValueError, match=r"nu\.vtr: z coordinates are not uniformly spaced \(largest relative "
+                                         r"deviation of a step from the mean step: 0\.333\)"):
+        read_volume(tmp_path / "nu.vtr")
+
+
+def test_structured_grid_lattice_accepted_curvilinear_refused():
+    zz, yy, xx = np.meshgrid(np.arange(3.0), np.arange(3.0) * 2, np.arange(4.0) * 0.5, indexing="ij")
+    sg = pv.StructuredGrid(xx.transpose(2, 1, 0), yy.transpose(2, 1, 0), zz.transpose(2, 1, 0))
+    sg.point_data["v"] = np.arange(36.0)
+    g = read_volume(sg)
+    assert g.spacing == (0.5, 2.0, 1.0) and g.values[1, 2, 3] == 23
+    pts = sg.points.copy()
+    pts[:, 0] += 0.1 * pts[:, 1]  # shear
+    sg.points = pts
+    with pytest.raises(ValueError, match="not an axis-aligned lattice"):
+        read_volume(sg)
+
+
+# ---- raw files ---------------------------------------------------------------------------------------------
+def test_raw_with_header_and_big_endian(tmp_path):
+    a = values_of("uint16", (2, 3, 4))
+    (tmp_path / "h.raw").write_bytes(b"HEADER!!" + a.astype(">u2").tobytes())
+    g = read_volume(tmp_path / "h.raw", shape=(2, 3, 4), dtype="uint16", byteorder="big", header_bytes=8,
+                    spacing=(1e3, 1e3, 2e3), origin=(1e6, 1e6, -1e6))
+    assert np.array_equal(g.values, a) and g.origin == (1e6, 1e6, -1e6) and g.spacing == (1e3, 1e3, 2e3)
+    assert read_volume(tmp_path / "h.raw", shape=(2, 3, 4), dtype=">u2", header_bytes=8).dtype == "uint16"
+
+
+def test_raw_size_mismatch_says_expected_actual_and_fix(tmp_path):
+    a = values_of("uint16", (2, 3, 4))
+    (tmp_path / "s.raw").write_bytes(b"\0" * 16 + a.astype("<u2").tobytes())
+    with pytest.raises(ValueError, match=r"s\.raw: expected 48 bytes \(0 header \+ 2 x 3 x 4 samples x 2 bytes of "
+                                         r"uint16\), the file has 64\. Likely fix: .*header_bytes=16"):
+        read_volume(tmp_path / "s.raw", shape=(2, 3, 4), dtype="uint16", byteorder="little")
+    (tmp_path / "f.raw").write_bytes(a.astype("<f4").tobytes())
+    with pytest.raises(ValueError, match=r"expected 48 bytes .* the file has 96\. Likely fix: the data are 4 bytes "
+                                         r"per sample, not 2: check dtype"):
+        read_volume(tmp_path / "f.raw", shape=(2, 3, 4), dtype="uint16", byteorder="little")
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({}, r"a headerless raw file needs shape= and dtype=, e\.g\. read_volume\("),
+    ({"shape": (2, 2, 2)}, r"needs dtype="),
+    ({"shape": (2, 2, 2), "dtype": "int16"}, r"int16 samples take 2 bytes; pass byteorder='little'"),
+    ({"shape": (2, 2, 2), "dtype": "int16", "byteorder": "middle"}, r"byteorder 'middle' is not known"),
+    ({"shape": (2, 2), "dtype": "uint8"}, r"shape must be three sample counts \(nz, ny, nx\)"),
+    ({"shape": (2, 2, 2), "dtype": "<u2", "byteorder": "big"}, r"says little-endian but byteorder='big'"),
+])
+def test_raw_missing_or_bad_arguments(tmp_path, kwargs, match):
+    (tmp_path / "x.raw").write_bytes(bytes(16))
+    with pytest.raises(ValueError, match=match):
+        read_volume(tmp_path / "x.raw", **kwargs)
+
+
+def test_raw_arguments_refused_for_self_describing_sources(tmp_path):
+    write_volume(grid_of("uint8"), tmp_path / "a.nrrd")
+    with pytest.raises(ValueError, match=r"shape= describe headerless raw files"):
+        read_volume(tmp_path / "a.nrrd", shape=(3, 4, 5))
+    with pytest.raises(ValueError, match="carries its own spacing and origin; spacing= would override"):
+        read_volume(tmp_path / "a.nrrd", spacing=(1, 1, 1))
+
+
+# ---- missing samples ---------------------------------------------------------------------------------------
+def test_nan_error_names_voxel_world_position_and_fill():
+    a = np.arange(60.0).reshape(3, 4, 5)
+    a[2, 1, 3] = np.nan
+    a[0, 0, 0] = np.inf
+    with pytest.raises(ValueError, match=r"numpy array: 2 of 60 samples are NaN/inf; the first at voxel \[k, j, i\] = "
+                                         r"\[0, 0, 0\], world \(x, y, z\) = \(1000000\.0, 0\.0, 0\.0\), value inf\. "
+                                         r"Pass fill='nearest' .* or a number, e\.g\. fill=0\.0"):
+        read_volume(a, origin=(1e6, 0.0, 0.0))
+    a[0, 0, 0] = 0.0
+    with pytest.raises(ValueError, match=r"\[2, 1, 3\], world \(x, y, z\) = \(1\.5, 2\.0, 6\.0\)"):
+        read_volume(a, spacing=(0.5, 2.0, 3.0))
+    # nearest in world distance: x neighbours (0.5 away) beat z neighbours (3 away)
+    g = read_volume(a, spacing=(0.5, 2.0, 3.0), fill="nearest")
+    assert g.values[2, 1, 3] in (a[2, 1, 2], a[2, 1, 4])
+    assert read_volume(a, fill=-1.0).values[2, 1, 3] == -1.0
+    with pytest.raises(ValueError, match="fill 'mean' is not known; choose 'nearest' or a finite number"):
+        read_volume(a, fill="mean")
+
+
+def test_nan_position_after_flip_is_in_the_returned_grid(tmp_path):
+    a = np.zeros((2, 2, 3), dtype=np.float32)
+    a[0, 0, 0] = np.nan  # stored first, but the x axis is flipped: returned i = 2
+    write_volume(VolumeGrid(np.zeros((2, 2, 3))), tmp_path / "n.vti", direction=np.diag([-1.0, 1, 1]))
+    img = pv.read(tmp_path / "n.vti")
+    img.point_data["values"] = a.ravel()
+    with pytest.raises(ValueError, match=r"voxel \[k, j, i\] = \[0, 0, 2\] \(after reversing the flipped axes x\), "
+                                         r"world \(x, y, z\) = \(0\.0, 0\.0, 0\.0\)"):
+        read_volume(img)
+
+
+# ---- bad inputs -----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("value, kwargs, exc, match", [
+    (np.zeros((4, 5)), {}, ValueError, r"3-D array \(nz, ny, nx\), got shape \(4, 5\)\. A 2-D image is a height "
+                                       r"field: use splinevis\.io\.read_heights"),
+    (np.zeros((1, 4, 5)), {}, ValueError, r"at least 2 samples on every axis; shape \(nz, ny, nx\) = \(1, 4, 5\) has 1 "
+                                          r"along z\. A single slice"),
+    (np.zeros((2, 2, 2), dtype=complex), {}, TypeError, "real numbers, got dtype complex128"),
+    (np.array([[["a", "b"]] * 2] * 2), {}, TypeError, r"\(strings\)"),
+    (np.zeros((2, 2, 2)), {"spacing": (1.0, 0.0, 1.0)}, ValueError, r"spacing must be > 0 on every axis"),
+    (np.zeros((2, 2, 2)), {"origin": (np.nan, 0, 0)}, ValueError, r"origin must be finite"),
+    (np.zeros((2, 2, 2)), {"scalars": "v"}, ValueError, r"a numpy array has none"),
+    (np.full((2, 2, 2), 2**60, dtype=np.int64), {}, ValueError, r"not exact in float64"),
+    ({"v": 1}, {}, TypeError, r"source of type dict is not supported; pass a 3-D numpy array"),
+])
+def test_bad_inputs(value, kwargs, exc, match):
+    with pytest.raises(exc, match=match):
+        read_volume(value, **kwargs)
+
+
+def test_flat_image_and_pyvista_geometry_refused():
+    img = pv.ImageData(dimensions=(4, 4, 1))
+    img.point_data["v"] = np.zeros(16)
+    with pytest.raises(ValueError, match=r"has 1 along z\. A single slice is a 2-D image"):
+        read_volume(img)
+    img3 = pv.ImageData(dimensions=(2, 2, 2))
+    img3.point_data["v"] = np.zeros(8)
+    with pytest.raises(ValueError, match="carries its own spacing and origin; origin= would override"):
+        read_volume(img3, origin=(1, 2, 3))
+
+
+def test_missing_empty_unsupported_and_corrupt_files_name_the_path(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"volume file not found: .*nothere\.vti"):
+        read_volume(tmp_path / "nothere.vti")
+    (tmp_path / "empty.mha").write_bytes(b"")
+    with pytest.raises(ValueError, match=r"empty\.mha is empty \(0 bytes\)"):
+        read_volume(tmp_path / "empty.mha")
+    with pytest.raises(ValueError, match=r"x\.xyz: extension '\.xyz' is not supported"):
+        read_volume(tmp_path / "x.xyz")
+    with pytest.raises(ValueError, match=r"NIfTI files are not read .* convert to NRRD"):
+        read_volume(tmp_path / "brain.nii")
+    with pytest.raises(ValueError, match="is a directory; DICOM series are not read"):
+        read_volume(tmp_path)
+    # MetaImage whose data are cut short: VTK only warns and returns garbage; we raise
+    g = grid_of("int16")
+    write_volume(g, tmp_path / "cut.mha")
+    blob = (tmp_path / "cut.mha").read_bytes()
+    (tmp_path / "cut.mha").write_bytes(blob[:-20])
+    with pytest.raises(ValueError, match=r"cut\.mha: could not be read as MetaImage"):
+        read_volume(tmp_path / "cut.mha")
+    write_volume(g, tmp_path / "cut.nrrd")
+    blob = (tmp_path / "cut.nrrd").read_bytes()
+    (tmp_path / "cut.nrrd").write_bytes(blob[:-20])
+    with pytest.raises(ValueError, match=r"cut\.nrrd: the data hold \d+ bytes, sizes \[5, 4, 3\] of int16 need 120"):
+        read_volume(tmp_path / "cut.nrrd")
+    (tmp_path / "bad.nrrd").write_bytes(b"hello world\n")
+    with pytest.raises(ValueError, match=r"bad\.nrrd: not an NRRD file"):
+        read_volume(tmp_path / "bad.nrrd")
+    (tmp_path / "bad.slc").write_bytes(b"hello world\n")
+    with pytest.raises(ValueError, match=r"bad\.slc: could not be read as SLC"):
+        read_volume(tmp_path / "bad.slc")
+
+
+def test_volumegrid_rescale_field_and_axes():
+    g = VolumeGrid(np.zeros((2, 2, 3)), spacing=(0.5, 1.0, 2.0), origin=(1.0, 0.0, 0.0))
+    assert g.rescale == (1.0, 0.0)
+    x, y, z = g.axes()
+    assert x.tolist() == [1.0, 1.5, 2.0] and z.tolist() == [0.0, 2.0]
+    with pytest.raises(ValueError, match="rescale must be"):
+        VolumeGrid(np.zeros((2, 2, 2)), rescale=(0.0, 1.0))
