@@ -1,4 +1,4 @@
-"""The ``splinevis`` command: ``info``, ``selftest``, ``demo``, ``study terrain``.
+"""The ``splinevis`` command: ``info``, ``selftest``, ``demo``, ``study terrain``, ``study volume``.
 
 Exit codes: 0 success, 1 the job ran and failed (selftest over its bounds), 2 bad usage, 3 no OpenGL.
 """
@@ -68,7 +68,18 @@ def _cmd_study(args) -> int:
             print(f)
         print(out / "terrain.json")
         return 0 if result else 1
-    raise ValueError(f"study {args.name!r} is not known; choose 'terrain'.")
+    if args.name == "volume":
+        from .studies.volume import run_volume_study
+
+        result = run_volume_study(args.out, quick=args.quick, progress=not args.quiet)
+        out = Path(args.out)
+        for f in sorted(out.glob("*.md")) + sorted(out.glob("*.png")):
+            print(f)
+        print(out / "volume.json")
+        if not result["cubic"]["available"]:
+            print(f"note: {result['cubic']['note']}")
+        return 0 if result else 1
+    raise ValueError(f"study {args.name!r} is not known; choose 'terrain' or 'volume'.")
 
 
 def main(argv=None) -> int:
@@ -88,7 +99,7 @@ def main(argv=None) -> int:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_demo)
     p = sub.add_parser("study", help="run a study (accuracy vs time) and write JSON, tables and figures")
-    p.add_argument("name", choices=["terrain"])
+    p.add_argument("name", choices=["terrain", "volume"])
     p.add_argument("--out", required=True, help="directory for the study's files")
     p.add_argument("--quick", action="store_true", help="smaller sizes: a few minutes")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

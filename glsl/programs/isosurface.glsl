@@ -4,8 +4,9 @@
 // Proxy: one box per relevant cube (splinevis.volume.program), rasterized with front faces culled, so
 // each fragment lies on the cube's far side and the camera may be inside the volume. The fragment tests
 // the relevant tetrahedra of its own cube (bit mask, a flat vertex attribute):
-// 1. clip the ray by the tetrahedron's barycentric coordinates (paper 003, sec. 5.3: lam_i >= 0), with a
-//    margin against cracks between neighbours;
+// 1. clip the ray by the tetrahedron's barycentric coordinates (paper 003, sec. 5.3: lam_i >= 0), with
+//    margins against cracks between neighbours (a wide one across the cube's faces, where neighbouring
+//    fragments round the ray independently and the splines are C1, and a narrow one inside the cube);
 // 2. BB coefficients of s on the tetrahedron: recomputed from the cube's 27 data values with the scheme's
 //    averaging rules (encoding "data", the determining data of paper 003 sec. 5.1 taken to the limit: one
 //    value per cube) or read from a table (encoding "coefficients": every coefficient stored);
@@ -29,7 +30,8 @@ uniform vec3 sv_inv_spacing;      // index-space direction = sv_inv_spacing * mo
 uniform float sv_iso_shifted;     // isovalue - sv_value_ref (the textures hold data - sv_value_ref)
 uniform float sv_value_ref;
 uniform int sv_newton_iterations;
-uniform float sv_tet_margin;      // clip margin in barycentric units
+uniform float sv_cube_margin;     // clip margins in barycentric units: lam_0 (the face on the cube's boundary)
+uniform float sv_inner_margin;    // and lam_1..3 (faces inside the cube), see splinevis.volume.program
 uniform int sv_tex_width;         // texels per row of the data / coefficient texture
 uniform vec3 sv_padded_dims;      // (nx + 2, ny + 2, nz + 2)
 uniform vec3 sv_cube_count;       // (nx, ny, nz): hit.uv = (x, y) / (nx, ny)
@@ -137,7 +139,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         float tb = 3.0e38;
         bool empty = false;
         for (int i = 0; i < 4; ++i) {
-            float lim = -sv_tet_margin - lo[i];
+            float lim = -(i == 0 ? sv_cube_margin : sv_inner_margin) - lo[i];
             if (ld[i] > 0.0) ta = max(ta, lim / ld[i]);
             else if (ld[i] < 0.0) tb = min(tb, lim / ld[i]);
             else if (lim > 0.0) empty = true;

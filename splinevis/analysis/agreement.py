@@ -3,7 +3,9 @@
 The model is rendered alone (unlit, no effects: depth does not depend on shading), the depth buffer is
 read back, and every pixel's ray is cast in float64 by the model's reference ray caster with the same
 camera matrix. Depth differences are judged against a derived per-pixel bound
-(:func:`splinevis.analysis.bounds.ray_depth_error_bound`).
+(:func:`splinevis.analysis.bounds.ray_depth_error_bound` or ``isosurface_depth_error_bound``) plus the depth
+change over the rasterizer's sub-pixel snapping (:func:`subpixel_depth_slack`; found on a one-voxel sheet whose
+isosurface lies on cube faces: the shader's rays were those of points up to 2^-8 px off the pixel centre).
 """
 
 from __future__ import annotations
@@ -79,6 +81,38 @@ def _shift(matrix, off):
     return np.asarray(matrix) @ T
 
 
+#: Sub-pixel precision of the rasterizer: vertices are snapped to 2^-8 of a pixel (llvmpipe's fixed-point
+#: setup, FIXED_ORDER = 8; the same order as GPUs' 8 sub-pixel bits).
+SUBPIXEL = 2.0 ** -8
+
+
+def subpixel_depth_slack(ref_depth: np.ndarray) -> np.ndarray:
+    """Depth change over a sub-pixel offset of the ray: ``SUBPIXEL * (|d depth/dx| + |d depth/dy|)`` per pixel.
+
+    The shader's ray passes through the fragment's interpolated position on the proxy, and the proxy's
+    vertices were snapped to SUBPIXEL before interpolation: the ray is that of a point up to SUBPIXEL
+    (per axis) away from the pixel centre. The slope is the larger one-sided difference of the float64
+    reference depth to a neighbour that also hits (0 where none does).
+    """
+    r = np.asarray(ref_depth, dtype=np.float64)
+    ok = np.isfinite(r) & (r >= 0) & (r <= 1)
+    slope = np.zeros_like(r)
+    for axis in (0, 1):
+        for shift in (1, -1):
+            nb = np.roll(r, shift, axis=axis)
+            nok = np.roll(ok, shift, axis=axis)
+            edge = np.zeros_like(ok)
+            if axis == 0:
+                edge[0 if shift == 1 else -1, :] = True
+            else:
+                edge[:, 0 if shift == 1 else -1] = True
+            diff = np.where(ok & nok & ~edge, np.abs(r - nb), 0.0)
+            slope_axis = diff if shift == 1 else np.maximum(prev, diff)
+            prev = slope_axis
+        slope += slope_axis
+    return SUBPIXEL * slope
+
+
 def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_iterations=8, plotter_hook=None) -> dict:
     """Render ``model`` alone from ``camera_position`` and compare with the float64 reference.
 
@@ -107,7 +141,7 @@ def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_it
     gpu_hit = gpu < 1.0
     both = gpu_hit & ref_hit
     interior = ndimage.binary_erosion(ref_hit, structure=np.ones((3, 3)), border_value=0)
-    bound = _bound(model, matrix, o[both], d[both], hits.t[both])
+    bound = _bound(model, matrix, o[both], d[both], hits.t[both]) + subpixel_depth_slack(ref)[both]
     return {
         "pixels": w * h,
         "hit_disagree": int((gpu_hit != ref_hit).sum()),

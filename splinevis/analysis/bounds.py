@@ -86,8 +86,9 @@ def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matri
     * value of g(t) = s(ray(t)) - iso as the shader computes it: data stored as float32 (u F, F =
       ``value_scale``), a coefficient as a sum of at most 27 weighted data (27 u F), restriction to the
       segment by n levels of 4-term barycentric combinations (4 n u F, the barycentric weights on the
-      segment are near the tetrahedron), the isovalue subtracted (u F) and the univariate root finder's
-      residual test (3 n u F): eps_f = (29 + 7 n) u F.
+      segment are near the tetrahedron), the isovalue subtracted (u F) and the root finders' acceptance:
+      a Newton root is accepted at a residual up to K_n eps32 S = 6 n u S (splinevis.bb.roots.root_tolerance_k,
+      S <= F): eps_f = (29 + 10 n) u F.
     * position: the cube-local start point is interpolated across the proxy face from exact corners
       (about 16 u of a cube) and the direction is normalized and scaled (3 u relative over at most 2 cube
       diagonals): a shift of 24 u cubes, i.e. eps_x = 24 u |grad s| h with h the largest spacing.
@@ -104,7 +105,7 @@ def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matri
     gnorm = np.linalg.norm(grad, axis=-1)
     gprime = np.abs(np.einsum("...i,...i->...", grad, d))
     h = float(np.max(spacing))
-    eps = (29 + 7 * degree) * U32 * value_scale + 24.0 * U32 * gnorm * h
+    eps = (29 + 10 * degree) * U32 * value_scale + 24.0 * U32 * gnorm * h
     dl = 1e-6 * np.maximum(1.0, np.abs(t))
 
     def slope(tt):

@@ -44,6 +44,20 @@ def tet_weights(scheme: str) -> np.ndarray:
     return _schemes.derive_weights()["W"][tmap]
 
 
+def pad_linear(values: np.ndarray) -> np.ndarray:
+    """One layer of linear extrapolation around a (nz, ny, nx) volume, ``f[-1] = 2 f[0] - f[1]`` axis by axis
+    (corners too), in one allocation; keeps linear data linear (docs/volume-schemes.md, "Boundary")."""
+    v = np.asarray(values, dtype=np.float64)
+    nz, ny, nx = v.shape
+    P = np.empty((nz + 2, ny + 2, nx + 2))
+    P[1:-1, 1:-1, 1:-1] = v
+    for ax in range(3):
+        Q = np.moveaxis(P, ax, 0)  # a view
+        np.subtract(2 * Q[1], Q[2], out=Q[0])
+        np.subtract(2 * Q[-2], Q[-3], out=Q[-1])
+    return P
+
+
 def _negative_mass(W: np.ndarray) -> float:
     """Largest total negative weight of any coefficient: every coefficient (weights summing to 1) then
     lies in ``[min - N (max - min), max + N (max - min)]`` of its 27 data values."""
@@ -118,7 +132,7 @@ class VolumeSpline:
         self.weights = tet_weights(scheme)
         self.ncoef = self.weights.shape[1]
         t0 = time.perf_counter()
-        self.padded = getattr(_schemes, 'pad_volume', _schemes._pad)(grid.values)
+        self.padded = pad_linear(grid.values)
         self._octree = None
         self.setup_seconds = time.perf_counter() - t0
 
@@ -199,19 +213,26 @@ class VolumeSpline:
     def cube_ranges(self) -> tuple:
         """Per-cube ``(lo, hi)`` float32 bounds of the cube's BB coefficients (rounded outward), from the min
         and max of its 27 data values and the scheme's negative weight mass."""
-        from scipy import ndimage
-
-        P = self.padded
-        mn = ndimage.minimum_filter(P, size=3, mode="nearest")[1:-1, 1:-1, 1:-1]
-        mx = ndimage.maximum_filter(P, size=3, mode="nearest")[1:-1, 1:-1, 1:-1]
+        P = self.padded.astype(np.float32)  # rounding is undone by the outward nextafter below
+        mn, mx = _box3(P, np.minimum), _box3(P, np.maximum)
         N = _negative_mass(self.weights)
         if N > 0:
             spread = mx - mn
-            mn = mn - N * spread
-            mx = mx + N * spread
-        lo = np.nextafter(mn.astype(np.float32), np.float32(-np.inf))
-        hi = np.nextafter(mx.astype(np.float32), np.float32(np.inf))
+            mn = mn - np.float32(N) * spread * np.float32(1 + 1e-6)
+            mx = mx + np.float32(N) * spread * np.float32(1 + 1e-6)
+        # float32 of a float64 value is within half an ulp: one step outward encloses the float64 range
+        # (with N > 0 the extra products are covered by the relative widening of 1e-6 above)
+        lo = np.nextafter(mn, np.float32(-np.inf), out=mn)
+        hi = np.nextafter(mx, np.float32(np.inf), out=mx)
         return lo, hi
+
+    def _distinct_weights(self):
+        """(27, D) weights of the cube's distinct coefficients and the (24, m) map into them."""
+        if getattr(self, "_distinct", None) is None:
+            flat = self.weights.reshape(-1, 27)
+            uniq, inv = np.unique(np.round(flat, 15), axis=0, return_inverse=True)
+            self._distinct = (np.ascontiguousarray(uniq.T), inv.reshape(NUM_TETS, self.ncoef))
+        return self._distinct
 
     @property
     def octree(self) -> MinMaxOctree:
@@ -232,12 +253,21 @@ class VolumeSpline:
         cand = self.octree.candidates(iso)
         cubes, masks = [], []
         bits = (np.int64(1) << np.arange(NUM_TETS, dtype=np.int64))
+        # the 24 m coefficients of a cube are few distinct combinations of its data (65 for the quadratic,
+        # shared between neighbouring tetrahedra): compute those once, then min/max per tetrahedron with
+        # m - 1 elementwise operations on (n, 24) gathers
+        Wd, tmap = self._distinct_weights()
         for s in range(0, len(cand), chunk):
             c = cand[s:s + chunk]
-            coef = self.cube_coefficients(c)
-            lo, hi = coef.min(axis=2), coef.max(axis=2)  # (n, 24)
+            coef = self.stencil_data(c) @ Wd  # (n, distinct)
+            lo = coef[:, tmap[:, 0]]
+            hi = lo.copy()
+            for q in range(1, self.ncoef):
+                col = coef[:, tmap[:, q]]
+                np.minimum(lo, col, out=lo)
+                np.maximum(hi, col, out=hi)
             rel = (lo <= iso) & (iso <= hi)
-            m = (rel * bits).sum(axis=1)
+            m = rel @ bits
             keep = m != 0
             cubes.append(c[keep])
             masks.append(m[keep])
@@ -249,6 +279,13 @@ class VolumeSpline:
         nz, ny, nx = self.shape
         return (f"VolumeSpline({self.scheme}, {nx}x{ny}x{nz} cubes, spacing={self.grid.spacing}, origin={self.grid.origin}, "
                 f"source={self.grid.source!r})")
+
+
+def _box3(P: np.ndarray, op) -> np.ndarray:
+    """op over the 3 x 3 x 3 neighbourhood of every interior sample of a padded array (separable)."""
+    a = op(op(P[:-2], P[1:-1]), P[2:])
+    a = op(op(a[:, :-2], a[:, 1:-1]), a[:, 2:])
+    return op(op(a[:, :, :-2], a[:, :, 1:-1]), a[:, :, 2:])
 
 
 def _read(volume, options) -> VolumeGrid:

@@ -21,8 +21,9 @@ def _reduce(a: np.ndarray, fill: float, op) -> np.ndarray:
     pz, py, px = nz % 2, ny % 2, nx % 2
     if pz or py or px:
         a = np.pad(a, ((0, pz), (0, py), (0, px)), constant_values=fill)
-    z, y, x = a.shape
-    return op(op(op(a.reshape(z // 2, 2, y // 2, 2, x // 2, 2), axis=5), axis=3), axis=1)
+    a = op(a[0::2], a[1::2])
+    a = op(a[:, 0::2], a[:, 1::2])
+    return op(a[:, :, 0::2], a[:, :, 1::2])
 
 
 class MinMaxOctree:
@@ -48,7 +49,7 @@ class MinMaxOctree:
         self.levels = [(lo, hi)]
         while max(self.levels[-1][0].shape) > 1:
             a, b = self.levels[-1]
-            self.levels.append((_reduce(a, np.inf, np.min), _reduce(b, -np.inf, np.max)))
+            self.levels.append((_reduce(a, np.inf, np.minimum), _reduce(b, -np.inf, np.maximum)))
 
     @property
     def depth(self) -> int:

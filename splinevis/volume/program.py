@@ -28,14 +28,20 @@ from ..gl.spec import ProgramSpec
 from .model import Relevant, VolumeSpline
 
 __all__ = ["Isosurface", "isosurface_program", "data_texture", "coefficient_table", "memory_report",
-           "TEXTURE_WIDTH", "TET_MARGIN"]
+           "TEXTURE_WIDTH", "CUBE_MARGIN", "INNER_MARGIN"]
 
 #: Texels per row of the linear data/coefficient textures (GL_MAX_TEXTURE_SIZE of llvmpipe is 16384).
 TEXTURE_WIDTH = 8192
-#: Clip margin (barycentric units) of every tetrahedron, against cracks between neighbours: the
-#: interpolated cube-local fragment position is accurate to a few float32 ulps of 1 (~1e-7); 2^-16 leaves
-#: a factor > 100.
-TET_MARGIN = 2.0**-16
+#: Clip margin (barycentric units) across the cube's faces (lam_0 >= -margin; lam_0 vanishes on the face of
+#: the cube that tetrahedron [vQ, wF, u, u'] touches), against cracks between neighbouring cubes: each cube's
+#: fragment gets its cube-local position by interpolation from exact corners, accurate to a few float32 ulps
+#: of 1 (~1e-7); 2^-16 leaves a factor > 100. Both schemes are C1 across cube faces, so a polynomial
+#: extended this far differs from its neighbour by O(margin^2) only.
+CUBE_MARGIN = 2.0**-16
+#: Margin across the faces inside a cube. One fragment computes all its tetrahedra from the same ray, so
+#: only the rounding of the face parameters (~1e-7) must be covered; kept small because the quadratic
+#: scheme is only C0 across 12 inner faces, where an extension deviates by margin x (normal-derivative jump).
+INNER_MARGIN = 2.0**-21
 
 _CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
                     dtype=np.float64)
@@ -192,7 +198,8 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
             "sv_iso_shifted": model.isovalue - ref,
             "sv_value_ref": ref,
             "sv_newton_iterations": iterations,
-            "sv_tet_margin": TET_MARGIN,
+            "sv_cube_margin": CUBE_MARGIN,
+            "sv_inner_margin": INNER_MARGIN,
             "sv_tex_width": TEXTURE_WIDTH,
             "sv_padded_dims": (float(nx + 2), float(ny + 2), float(nz + 2)),
             "sv_cube_count": (float(nx), float(ny), float(nz)),

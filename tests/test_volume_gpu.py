@@ -1,0 +1,207 @@
+"""The volume isosurface program on the GPU (glsl/programs/isosurface.glsl) against its float64 twin.
+
+Every comparison renders the isosurface alone and checks, per pixel (splinevis.analysis.agreement):
+no leaks (a GPU miss whose reference and all 8 neighbours hit: a crack), at most 0.1 % of pixels where
+exactly one side hits (silhouette pixels where the ray grazes the surface within rounding), and at least
+99.9 % of the depths within the derived per-pixel bound
+(splinevis.analysis.bounds.isosurface_depth_error_bound).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import splinevis
+from splinevis.analysis.agreement import depth_agreement
+from splinevis.io.volumes import VolumeGrid
+from splinevis.volume.model import MIN_SAMPLES, SCHEME_DEGREE, VolumeSpline
+from splinevis.volume.program import Isosurface, isosurface_program
+
+pytestmark = pytest.mark.gl
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def sphere_grid(n=20, radius=0.7, spacing=None, origin=None, dtype=np.float64, noise=0.0):
+    x = np.linspace(-1, 1, n)
+    z, y, xx = np.meshgrid(x, x, x, indexing="ij")
+    v = np.sqrt(xx ** 2 + y ** 2 + z ** 2)
+    if noise:
+        v = v + np.random.default_rng(0).normal(scale=noise, size=v.shape)
+    h = 2.0 / (n - 1)
+    sp = np.array(spacing if spacing is not None else (h, h, h), dtype=float)
+    org = np.array(origin if origin is not None else -1.0 * sp * (n - 1) / 2)
+    return VolumeGrid(v.astype(dtype), spacing=tuple(sp), origin=tuple(org))
+
+
+def agreement(model, camera, size=(160, 120), options=None, iterations=6):
+    orig = splinevis.Plotter.add_spline
+
+    def hook(pl):  # depth_agreement adds the model itself; pass program options through a hook
+        return None
+
+    if options:
+        def add(self, m, style=None, **kw):
+            kw["program_options"] = options
+            kw["newton_iterations"] = iterations
+            return orig(self, m, style, **kw)
+
+        splinevis.Plotter.add_spline = add
+    try:
+        r = depth_agreement(model, camera, size, newton_iterations=iterations, plotter_hook=hook)
+    finally:
+        splinevis.Plotter.add_spline = orig
+    return r
+
+
+def check(r, min_hits=500):
+    assert r["both"] >= min_hits, r["both"]
+    assert r["leaks"] == 0, r["leaks"]
+    assert r["hit_disagree"] <= 0.001 * r["pixels"], r["hit_disagree"]
+    within = float(np.mean(r["depth_error"] <= r["depth_bound"]))
+    assert within >= 0.999, (within, float(np.max(r["depth_error"] / r["depth_bound"])))
+
+
+def test_generated_glsl_is_current():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("gen_volume_glsl", ROOT / "tools" / "gen_volume_glsl.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    for name, text in gen.generate().items():
+        assert (ROOT / "glsl" / "lib" / name).read_text() == text, f"run python tools/gen_volume_glsl.py ({name} is stale)"
+
+
+CAM = [(3.0, 2.0, 2.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+
+
+@pytest.mark.parametrize("options", [{}, {"encoding": "coefficients"}, {"roots": "bracketed"}],
+                         ids=["data-analytic", "table", "bracketed"])
+def test_quadratic_sphere_matches_twin(options):
+    iso = Isosurface(VolumeSpline(sphere_grid()), 0.7)
+    check(agreement(iso, CAM, options=options))
+
+
+def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
+    # Paper 003's fixed-iteration Newton from secure starts (here 0, 1/3, 2/3, 1 for a quadratic) has no
+    # bracket: a start that has not converged fails the residual test, and the smallest ACCEPTED iterate can
+    # be a later root (measured ~1.4 % of the pixels of this view, whatever the iteration count) or none.
+    # It stays selectable so the study can measure it. What must hold: it never reports a hit in front of
+    # the true surface or where there is none, and it is right (within the bound) on almost all pixels;
+    # the 5 % ceiling is a regression guard on a measured rate, not a derived tolerance.
+    iso = Isosurface(VolumeSpline(sphere_grid()), 0.7)
+    r = agreement(iso, CAM, options={"roots": "paper"}, iterations=5)
+    ref_hit = np.isfinite(r["reference_depth"])
+    gpu_hit = r["gpu_depth"] < 1.0
+    assert not (gpu_hit & ~ref_hit).any()
+    both = gpu_hit & ref_hit
+    wrong = r["depth_error"] > r["depth_bound"]
+    assert np.all(r["gpu_depth"][both][wrong] > r["reference_depth"][both][wrong])  # later, not earlier
+    assert wrong.mean() + (ref_hit & ~gpu_hit).sum() / ref_hit.sum() <= 0.05
+
+
+@pytest.mark.skipif("cubic" not in SCHEME_DEGREE, reason="never: cubic is part of SCHEME_DEGREE")
+def test_cubic_sphere_matches_twin():
+    iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
+    check(agreement(iso, CAM))
+
+
+def test_anisotropic_spacing_and_utm_sized_origin():
+    g = sphere_grid(spacing=(0.05, 0.12, 0.08), origin=(5.0e5, 4.2e6, 1.0e3))
+    iso = Isosurface(VolumeSpline(g), 0.7)
+    c = np.array(VolumeSpline(g).bounds).reshape(3, 2).mean(axis=1)
+    check(agreement(iso, [tuple(c + [3.0, 2.0, 2.5]), tuple(c), (0, 0, 1)]))
+
+
+def test_huge_spacing():
+    g = sphere_grid(spacing=(1.0e3, 1.0e3, 1.0e3), origin=(0.0, 0.0, 0.0))
+    s = VolumeSpline(g)
+    c = np.array(s.bounds).reshape(3, 2).mean(axis=1)
+    check(agreement(Isosurface(s, 0.7), [tuple(c + np.array([3.0, 2.0, 2.5]) * 8e3), tuple(c), (0, 0, 1)]))
+
+
+def test_camera_inside_the_volume():
+    # the eye sits inside the domain (outside the sphere): proxies of cubes around and behind the eye
+    # are clipped by the near plane; back faces still produce the fragments.
+    iso = Isosurface(VolumeSpline(sphere_grid(n=24)), 0.5)
+    check(agreement(iso, [(0.9, 0.1, 0.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]), min_hits=2000)
+
+
+def test_noisy_data():
+    iso = Isosurface(VolumeSpline(sphere_grid(noise=0.02)), 0.7)
+    check(agreement(iso, CAM))
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.int16, np.float32])
+def test_integer_and_float32_data(dtype):
+    g = sphere_grid()
+    scale = {np.uint8: 200.0, np.uint16: 40000.0, np.int16: 20000.0, np.float32: 1.0}[dtype]
+    q = VolumeGrid(np.round(g.values * scale).astype(dtype) if dtype != np.float32 else g.values.astype(dtype),
+                   spacing=g.spacing, origin=g.origin)
+    check(agreement(Isosurface(VolumeSpline(q), 0.7 * scale + 0.5), CAM))
+
+
+def test_plateau_at_the_isovalue_and_thin_sheet():
+    # a plateau: data exactly equal to the isovalue on a block (every coefficient there equals it); the
+    # first point of the plateau along the ray is a root (s - iso = 0) and both sides agree on it.
+    n = 16
+    v = np.zeros((n, n, n))
+    v[4:12, 4:12, 4:12] = 1.0
+    v[6:10, 6:10, 6:10] = 2.0
+    iso = Isosurface(VolumeSpline(VolumeGrid(v)), 1.0)
+    check(agreement(iso, [(30.0, 22.0, 26.0), (7.5, 7.5, 7.5), (0, 0, 1)]), min_hits=300)
+    # a sheet one voxel thick (x = 8): an isosurface on both sides of the sheet, seen from the side
+    w = np.zeros((n, n, n))
+    w[:, :, 8] = 1.0
+    iso = Isosurface(VolumeSpline(VolumeGrid(w)), 0.5)
+    r = agreement(iso, [(30.0, 14.0, 10.0), (7.5, 7.5, 7.5), (0, 0, 1)])
+    check(r, min_hits=2000)
+
+
+def test_isovalue_outside_the_data_is_an_empty_scene():
+    s = VolumeSpline(sphere_grid())
+    for iso_value in (5.0, -1.0):
+        iso = Isosurface(s, iso_value)
+        assert len(iso.relevant.cubes) == 0
+        pl = splinevis.Plotter(off_screen=True, window_size=(80, 60))
+        pl.add_spline(iso)
+        pl.add_mesh(__import__("pyvista").Sphere(radius=0.2), color="red")
+        img = pl.screenshot()
+        assert pl.depth_buffer().min() < 1.0  # the mesh is drawn; the empty isosurface adds nothing
+        assert img.shape == (60, 80, 3)
+        pl.close()
+
+
+def test_constant_volume_at_its_value_and_flat_away_from_it():
+    v = np.full((6, 6, 6), 3.0)
+    s = VolumeSpline(v)
+    assert len(s.relevant(3.5).cubes) == 0
+    rel = s.relevant(3.0)
+    assert len(rel.cubes) == 216 and np.all(rel.masks == (1 << 24) - 1)
+
+
+def test_grids_smaller_than_the_stencil_are_refused():
+    with pytest.raises(ValueError, match=rf"at least {MIN_SAMPLES} samples along every axis"):
+        VolumeSpline(np.zeros((2, 2, 2)))
+    with pytest.raises(ValueError, match=r"\(nz, ny, nx\) = \(5, 2, 5\)"):
+        VolumeSpline(np.zeros((5, 2, 5)))
+
+
+def test_nan_voxels_are_refused_with_their_position():
+    v = np.zeros((5, 5, 5))
+    v[1, 2, 3] = np.nan
+    with pytest.raises(ValueError, match=r"\[1, 2, 3\]"):
+        VolumeSpline(v)
+
+
+def test_options_are_validated():
+    iso = Isosurface(VolumeSpline(sphere_grid(n=8)), 0.7)
+    with pytest.raises(ValueError, match="encoding"):
+        isosurface_program(iso, encoding="texture")
+    with pytest.raises(ValueError, match="roots"):
+        isosurface_program(iso, roots="cardano")
+    with pytest.raises(ValueError, match="isovalue must be finite"):
+        Isosurface(iso.spline, float("nan"))
