@@ -205,3 +205,31 @@ def test_options_are_validated():
         isosurface_program(iso, roots="cardano")
     with pytest.raises(ValueError, match="isovalue must be finite"):
         Isosurface(iso.spline, float("nan"))
+
+
+def test_changing_the_isovalue_keeps_octree_data_texture_and_program():
+    from splinevis.volume.program import set_isovalue
+
+    s = VolumeSpline(sphere_grid())
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_spline(Isosurface(s, 0.7), lights=0, color=(1.0, 0.0, 0.0))
+    pl.camera_position = CAM
+    pl.reset_camera_clipping_range()
+    pl.screenshot()
+    octree = s.octree
+    texture = actor._textures["sv_volume_data"]
+    programs = set(actor.program_ids)
+    big = (pl.depth_buffer() < 1).sum()
+    rel = set_isovalue(actor, 0.4)
+    assert len(rel.cubes) > 0
+    pl.render()  # (a plain screenshot() would return the cached image: pyvista sees no change of its own)
+    small = (pl.depth_buffer() < 1).sum()
+    assert s.octree is octree and actor._textures["sv_volume_data"] is texture
+    assert actor.program_ids == programs
+    # the sphere of radius 0.4 covers (0.4 / 0.7)^2 of the pixels of the one of radius 0.7 (same view)
+    assert abs(small / big - (0.4 / 0.7) ** 2) < 0.08
+    # and its depth agrees with a fresh build at 0.4
+    r = agreement(Isosurface(s, 0.4), CAM)
+    check(r, min_hits=300)
+    assert np.allclose(pl.depth_buffer()[pl.depth_buffer() < 1], r["gpu_depth"][pl.depth_buffer() < 1], atol=1e-6)
+    pl.close()

@@ -193,9 +193,8 @@ class SplineActor:
     """
 
     def __init__(self, spec: ProgramSpec, style: Style, renderer=None, *, cull_front: bool = True):
-        from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
-        from vtkmodules.vtkCommonCore import vtkCommand, vtkPoints
-        from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+        from vtkmodules.vtkCommonCore import vtkCommand
+        from vtkmodules.vtkCommonDataModel import vtkPolyData
         from vtkmodules.vtkRenderingCore import vtkActor
         from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
 
@@ -212,41 +211,22 @@ class SplineActor:
         entry = '#include "lib/raycast.glsl"\n' + entry
         self.assembled = assemble(entry, defines)
 
-        points = np.asarray(spec.points, dtype=np.float64)
-        tris = np.asarray(spec.triangles, dtype=np.int64)
         poly = vtkPolyData()
-        pts = vtkPoints()
-        pts.SetDataTypeToDouble()
-        pts.SetData(numpy_to_vtk(points, deep=True))
-        poly.SetPoints(pts)
-        cells = vtkCellArray()
-        offsets = np.arange(0, 3 * len(tris) + 1, 3, dtype=np.int64)
-        cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(tris.ravel(), deep=True))
-        poly.SetPolys(cells)
-
         mapper = vtkOpenGLPolyDataMapper()
         mapper.SetInputData(poly)
         mapper.ScalarVisibilityOff()
         mapper.SetVBOShiftScaleMethod(0)  # DISABLE_SHIFT_SCALE: vertexMC must be model coordinates
         vs_dec, vs_impl = _VS_DEC, _VS_IMPL
         fs_dec = _FS_DEC
-        per_vertex = [(name, values, "flat ") for name, values in spec.attributes.items()]
-        per_vertex += [(name, values, "") for name, values in spec.varyings.items()]
-        for name, values, qualifier in per_vertex:
-            arr = np.asarray(values, dtype=np.float32)
-            if arr.ndim == 1:
-                arr = arr[:, None]
-            k = arr.shape[1]
-            if arr.shape[0] != len(points) or not 1 <= k <= 4:
-                raise ValueError(f"vertex attribute {name} must be (N, 1..4) with N = {len(points)} proxy points, got {arr.shape}.")
+        for name, values, qualifier in self._per_vertex(spec):
+            k = 1 if np.ndim(values) == 1 else np.shape(values)[1]
             vtype = "float" if k == 1 else f"vec{k}"
-            vtk_arr = numpy_to_vtk(arr, deep=True)
-            vtk_arr.SetName(name)
-            poly.GetPointData().AddArray(vtk_arr)
             mapper.MapDataArrayToVertexAttribute(name, name, 0, -1)
             vs_dec += f"in {vtype} {name};\n{qualifier}out {vtype} {name}VSOut;\n"
             vs_impl += f"  {name}VSOut = {name};\n"
             fs_dec += f"{qualifier}in {vtype} {name}VSOut;\n"
+        self.poly = poly
+        self.set_geometry(spec.points, spec.triangles, {**spec.attributes, **spec.varyings})
         self.mapper = mapper
 
         actor = vtkActor()
@@ -278,6 +258,48 @@ class SplineActor:
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
         mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
+
+    @staticmethod
+    def _per_vertex(spec):
+        out = [(name, values, "flat ") for name, values in spec.attributes.items()]
+        return out + [(name, values, "") for name, values in spec.varyings.items()]
+
+    def set_geometry(self, points, triangles, per_vertex: dict) -> None:
+        """Replace the proxy geometry and its per-vertex arrays in place (same names and widths as the
+        program was built with); the compiled program, textures and uniforms are kept. This is what an
+        isovalue change costs (splinevis.volume.program.set_isovalue)."""
+        from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+        from vtkmodules.vtkCommonCore import vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkCellArray
+
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+        pts = vtkPoints()
+        pts.SetDataTypeToDouble()
+        pts.SetData(numpy_to_vtk(points, deep=True))
+        self.poly.SetPoints(pts)
+        cells = vtkCellArray()
+        offsets = np.arange(0, 3 * len(tris) + 1, 3, dtype=np.int64)
+        cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(tris.ravel(), deep=True))
+        self.poly.SetPolys(cells)
+        pd = self.poly.GetPointData()
+        for name, values in per_vertex.items():
+            arr = np.asarray(values, dtype=np.float32)
+            if arr.ndim == 1:
+                arr = arr[:, None]
+            if arr.shape[0] != len(points) or not 1 <= arr.shape[1] <= 4:
+                raise ValueError(f"vertex attribute {name} must be (N, 1..4) with N = {len(points)} proxy points, got {arr.shape}.")
+            vtk_arr = numpy_to_vtk(np.ascontiguousarray(arr), deep=True)
+            vtk_arr.SetName(name)
+            pd.RemoveArray(name)
+            pd.AddArray(vtk_arr)
+        self.poly.Modified()
+
+    def set_texture(self, name: str, array: np.ndarray) -> None:
+        """Replace one RGBA32F texture of the program (e.g. a coefficient table after an isovalue change)."""
+        tex = _float_texture(array, name)
+        self._textures[name] = tex
+        self.actor.GetProperty().SetTexture(name, tex)
 
     # VTK passes the vtkShaderProgram as call data; the decorator tells the wrapper its type.
     def _on_update_shader(self, caller, event, program=None):

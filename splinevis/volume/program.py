@@ -27,7 +27,7 @@ from .._validation import check_choice, check_degree
 from ..gl.spec import ProgramSpec
 from .model import Relevant, VolumeSpline
 
-__all__ = ["Isosurface", "isosurface_program", "data_texture", "coefficient_table", "memory_report",
+__all__ = ["Isosurface", "isosurface_program", "set_isovalue", "data_texture", "coefficient_table", "memory_report",
            "TEXTURE_WIDTH", "CUBE_MARGIN", "INNER_MARGIN"]
 
 #: Texels per row of the linear data/coefficient textures (GL_MAX_TEXTURE_SIZE of llvmpipe is 16384).
@@ -162,28 +162,13 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         raise ValueError("roots='analytic' is the closed form for quadratics; for the cubic scheme use "
                          "'bracketed' (default) or 'paper'.")
     rel = model.relevant
-    n = len(rel.cubes)
-    sp = spline.spacing
-    corners = (rel.cubes[:, None, :] - 0.5 + _CORNERS[None]) * sp  # model frame: origin at data point 0
-    points = corners.reshape(-1, 3)
-    tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
-    # Integers above 2^16 lose low bits on their way through VTK's vertex attributes here (measured: the
-    # low 7 bits of a 24-bit mask vanished), so masks and rows travel as 12-bit halves.
-    cube_attr = np.repeat(np.column_stack([rel.cubes, rel.masks & 4095]).astype(np.float64), 8, axis=0)
-    mask_hi = rel.masks >> 12
-    local = np.tile(_CORNERS, (n, 1))
+    points, tris, attributes, varyings = _proxies(spline, rel, encoding)
     ref = value_reference(spline)
-    textures, attributes = {}, {"sv_cube": cube_attr}
-    extra = np.zeros((n, 3))
-    extra[:, 0] = mask_hi
+    textures = {}
     if encoding == "data":
         textures["sv_volume_data"] = data_texture(spline)
     else:
-        table, rows = coefficient_table(spline, rel)
-        textures["sv_volume_coef"] = table
-        extra[:, 1] = rows >> 12
-        extra[:, 2] = rows & 4095
-    attributes["sv_cube_extra"] = np.repeat(extra, 8, axis=0)
+        textures["sv_volume_coef"] = coefficient_table(spline, rel)[0]
     nz, ny, nx = spline.shape
     return ProgramSpec(
         name="isosurface",
@@ -194,7 +179,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         defines={"SV_VOLUME_CUBIC": cubic, "SV_VOLUME_TABLE": encoding == "coefficients",
                  "SV_ROOTS_PAPER_NEWTON": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
         uniforms={
-            "sv_inv_spacing": tuple(1.0 / sp),
+            "sv_inv_spacing": tuple(1.0 / spline.spacing),
             "sv_iso_shifted": model.isovalue - ref,
             "sv_value_ref": ref,
             "sv_newton_iterations": iterations,
@@ -207,5 +192,48 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         },
         textures=textures,
         attributes=attributes,
-        varyings={"sv_local": local},
+        varyings=varyings,
     )
+
+
+def _proxies(spline: VolumeSpline, rel: Relevant, encoding: str):
+    """Bounding geometry of the relevant cubes: points (model frame), triangles, flat attributes, varyings."""
+    n = len(rel.cubes)
+    corners = (rel.cubes[:, None, :] - 0.5 + _CORNERS[None]) * spline.spacing  # model frame: origin at data point 0
+    tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
+    # Integers above 2^16 lose low bits on their way through VTK's vertex attributes here (measured: the
+    # low 7 bits of a 24-bit mask vanished), so masks and rows travel as 12-bit halves.
+    cube_attr = np.repeat(np.column_stack([rel.cubes, rel.masks & 4095]).astype(np.float64), 8, axis=0)
+    extra = np.zeros((n, 3))
+    extra[:, 0] = rel.masks >> 12
+    if encoding == "coefficients":
+        counts = np.bitwise_count(rel.masks).astype(np.int64)
+        rows = np.concatenate([[0], np.cumsum(counts)[:-1]]) if n else np.zeros(0, np.int64)
+        extra[:, 1] = rows >> 12
+        extra[:, 2] = rows & 4095
+    attributes = {"sv_cube": cube_attr, "sv_cube_extra": np.repeat(extra, 8, axis=0)}
+    return corners.reshape(-1, 3), tris, attributes, {"sv_local": np.tile(_CORNERS, (n, 1))}
+
+
+def set_isovalue(actor, isovalue: float) -> Relevant:
+    """Change the isovalue of a rendered isosurface in place.
+
+    Only what depends on the isovalue is rebuilt: the relevant cubes (found through the spline's existing
+    min-max octree), the proxy geometry, the ``sv_iso_shifted`` uniform and, for ``encoding="coefficients"``,
+    the coefficient table. The data texture, the octree and the compiled program are kept (tested).
+    Returns the new :class:`Relevant`.
+    """
+    model = actor.model
+    if not isinstance(model, Isosurface):
+        raise TypeError(f"set_isovalue needs the SplineActor of an Isosurface, got one of {type(model).__name__}.")
+    model.isovalue = float(isovalue)
+    if not np.isfinite(model.isovalue):
+        raise ValueError(f"isovalue must be finite, got {isovalue!r}.")
+    spline, rel = model.spline, model.relevant
+    encoding = "coefficients" if actor.spec.defines.get("SV_VOLUME_TABLE") else "data"
+    points, tris, attributes, varyings = _proxies(spline, rel, encoding)
+    actor.set_geometry(points, tris, {**attributes, **varyings})
+    if encoding == "coefficients":
+        actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
+    actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)
+    return rel
