@@ -157,12 +157,14 @@ class Plotter(pv.Plotter):
         return self.add_spline(model, style, **options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
-                       read_options: dict | None = None, newton_iterations: int = 6, **options):
+                       read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
+                       **options):
         """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data (paper 003).
 
         ``volume`` is a :class:`~splinevis.volume.VolumeSpline`, a :class:`~splinevis.io.VolumeGrid`, or
         anything :func:`splinevis.io.read_volume` reads (3-D array, pyvista ImageData, .vti/.nrrd/.mha/...
-        file); ``scheme`` ``"quadratic"`` or ``"cubic"`` (ignored for a VolumeSpline). Program options
+        file); ``scheme`` ``"quadratic"`` or ``"cubic"`` (ignored for a VolumeSpline). ``culling``: hierarchical
+        view-frustum culling of the proxies by the octree before every frame (``actor.culler``). Program options
         (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
         :meth:`add_spline`). An isovalue outside the data's range draws nothing. Returns the
         :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.program.Isosurface`.
@@ -180,8 +182,14 @@ class Plotter(pv.Plotter):
         from .volume.model import VolumeSpline
         from .volume.program import Isosurface
 
+        from .volume.culling import FrustumCuller
+
         spline = volume if isinstance(volume, VolumeSpline) else VolumeSpline(volume, scheme, **(read_options or {}))
-        return self.add_spline(Isosurface(spline, isovalue), style, newton_iterations=newton_iterations, **options)
+        actor = self.add_spline(Isosurface(spline, isovalue), style, newton_iterations=newton_iterations, **options)
+        if culling:
+            actor.culler = FrustumCuller(actor)
+            actor.culler.attach(self.renderer)
+        return actor
 
     def render(self) -> None:
         """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`."""

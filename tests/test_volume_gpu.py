@@ -234,3 +234,23 @@ def test_changing_the_isovalue_keeps_octree_data_texture_and_program():
     check(r, min_hits=300)
     assert np.allclose(pl.depth_buffer()[pl.depth_buffer() < 1], r["gpu_depth"][pl.depth_buffer() < 1], atol=1e-6)
     pl.close()
+
+
+def test_frustum_culling_draws_fewer_cubes_and_the_same_image():
+    from datasets_synthetic.volumes import marschner_lobb
+
+    g = marschner_lobb().sample(32)
+    out = {}
+    for cull in (False, True):
+        pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+        a = pl.add_isosurface(g, 0.5, culling=cull, lights=1)
+        pl.camera_position = [(0.9, 0.7, 0.9), (0.3, 0.2, 0.3), (0, 0, 1)]  # a close-up: most cubes outside
+        pl.camera.view_angle = 30
+        pl.reset_camera_clipping_range()
+        out[cull] = (pl.screenshot().copy(), pl.depth_buffer().copy(), a.poly.GetNumberOfCells() // 12,
+                     len(a.model.relevant.cubes))
+        pl.close()
+    assert np.array_equal(out[True][0], out[False][0]) and np.array_equal(out[True][1], out[False][1])
+    assert out[False][2] == out[False][3]
+    assert out[True][2] < 0.7 * out[True][3]
+    assert (out[True][1] < 1).sum() > 2000

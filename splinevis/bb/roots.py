@@ -634,3 +634,178 @@ def first_root_quadratic(c, *, dtype=np.float64):
         best = np.where((A != 0) & (disc < 0) & ok(ts) & touch, ts, best)
         best = np.where(C == 0, dt(0), best)
     return np.where(best <= 1, best, np.nan).astype(np.float64)
+
+
+# ----------------------------------------------------------------------------------------------------
+# stable closed form for cubics, and paper 003's Newton from three starts (issue 4)
+# ----------------------------------------------------------------------------------------------------
+
+__all__ += ["first_root_cubic", "newton_three_starts", "CUBIC_POLISH"]
+
+#: Newton steps polishing the closed-form candidates (``SV_CUBIC_POLISH`` in ``glsl/lib/roots.glsl``).
+CUBIC_POLISH = 2
+_SQRT3 = 1.7320508075688772
+
+
+def _cardano_real(P, Q, R, dt):
+    """mirrors glsl/lib/roots.glsl sv_cardano_real: real root of y^3 + 3 P y + Q, R = sqrt(Q^2 + 4 P^3)."""
+    s = dt(-0.5) * (Q + np.where(Q >= 0.0, R, -R))                 # s = -0.5 * (Q + (Q >= 0 ? R : -R))
+    u = (np.sign(s) * np.power(np.abs(s), dt(1.0 / 3.0))).astype(dt)  # sign(s) * pow(abs(s), 1.0 / 3.0)
+    v = np.where(u != 0.0, -P / np.where(u != 0.0, u, dt(1.0)), dt(0.0))
+    return np.where(P > 0.0, -Q / (u * u + v * v + P), u + v).astype(dt)
+
+
+def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
+    """First root in [0, 1] of cubic BB polynomials by a stable closed form (NaN if none).
+
+    Mirrors ``sv_first_root_cubic`` in ``glsl/lib/roots.glsl`` operation by operation (the GLSL's
+    ``atan``, ``cos``, ``sin``, ``pow``, ``log2`` and ``exp2`` are not correctly rounded, so the float32
+    twin agrees with the GPU only after the Newton polish, within the root's rounding level).
+
+    Method
+    ------
+    With ``x = t``, ``w = 1 - t`` the cubic is the binary form ``A x^3 + 3B x^2 w + 3C x w^2 + D w^3`` with
+    ``(A, B, C, D) = (c3, c2, c1, c0)``; roots ``(x : w)`` give ``t = x / (x + w)``, in [0, 1] iff ``x, w``
+    have the same sign. After exact power-of-two scaling (``max |c_k|`` in [1, 2)), the Hessian
+    ``d1 = AC - B^2, d2 = AD - BC, d3 = BD - C^2`` and ``disc = 4 d1 d3 - d2^2`` decide between
+
+    * ``disc >= 0``: the trigonometric solution of the two depressed forms ``y^3 + 3 d1 y + Q_A``
+      (``x = y - B, w = A``; ``Q_A = A d2 - 2 B d1``) and ``z^3 + 3 d3 z + Q_D`` (``x = D, w = z - C``;
+      ``Q_D = D d2 - 2 C d3``), taking from each the extreme root without cancellation (the largest and the
+      smallest ``|x / w|``), the third root from the quadratic cofactor, plus the A-form's middle root;
+    * ``disc < 0``: cancellation-free Cardano in both forms (the real root), and the real part of the
+      complex pair in both forms (a tangency candidate).
+
+    ``sqrt`` of the depressed discriminants is taken as ``|A| sqrt(|disc|)`` resp. ``|D| sqrt(|disc|)``
+    (exact identities). The four candidates (non-finite dropped, the rest clamped to [0, 1]) get ``polish``
+    Newton steps on the BB form; every iterate is tested with ``|f(x)| <= K_3 EPS32 sum |c_k| B_k(x)``
+    (:func:`root_tolerance_k`), each lane keeps its last passing iterate, the smallest wins.
+
+    Parameters
+    ----------
+    c : (..., 4) array_like
+        BB coefficients of degree 3 (non-finite values allowed: no root).
+    dtype : {numpy.float64, numpy.float32}
+        float32 emulates the GPU (without FMA).
+    polish : int
+        Newton steps after the closed form (0..4); the GLSL uses ``SV_CUBIC_POLISH`` (default 2).
+
+    Returns
+    -------
+    ndarray, shape ``c.shape[:-1]``
+        First root, NaN if none. ``c0 == 0`` (including the zero polynomial) gives 0.
+    """
+    c = _check_univariate(c, high=3, finite=False)
+    if c.shape[-1] != 4:
+        raise ValueError(f"first_root_cubic needs 4 coefficients (degree 3), got {c.shape[-1]}.")
+    if isinstance(polish, bool) or not isinstance(polish, (int, np.integer)) or not 0 <= polish <= 4:
+        raise ValueError(f"polish must be an integer in 0..4; got {polish!r}.")
+    dt = _check_dtype(dtype)
+    lead = c.shape[:-1]
+    cc = c.astype(dt).reshape(-1, 4)
+    two, half = dt(2.0), dt(0.5)
+    with np.errstate(all="ignore"):
+        finite = np.all(np.abs(cc) <= np.finfo(np.float32).max, axis=-1)
+        m = np.max(np.abs(cc), axis=-1)
+        e = np.clip(np.floor(np.log2(np.where(m > 0, m, dt(1.0)))), -126.0, 126.0).astype(dt)
+        cs = cc * np.exp2(-e).astype(dt)[:, None]                  # exact power-of-two scaling
+        A, B, C, D = cs[:, 3], cs[:, 2], cs[:, 1], cs[:, 0]
+        d1 = A * C - B * B
+        d2 = A * D - B * C
+        d3 = B * D - C * C
+        disc = dt(4.0) * d1 * d3 - d2 * d2
+        QA = dt(-2.0) * B * d1 + A * d2
+        QD = dt(-2.0) * C * d3 + D * d2
+        three_real = disc >= 0.0
+        # disc >= 0: trigonometric method
+        sq = np.sqrt(np.abs(disc))
+        s3 = dt(_SQRT3)
+        phA = np.arctan2(np.abs(A) * sq, -QA) / dt(3.0)
+        rA = np.sqrt(np.maximum(-d1, dt(0.0)))
+        cA, sA = np.cos(phA), np.sin(phA)
+        y1 = two * rA * cA
+        y3 = -rA * (cA + s3 * sA)
+        y2 = rA * (s3 * sA - cA)
+        yL = np.where(y1 + y3 > two * B, y1, y3)
+        phD = np.arctan2(np.abs(D) * sq, -QD) / dt(3.0)
+        rD = np.sqrt(np.maximum(-d3, dt(0.0)))
+        cD, sD = np.cos(phD), np.sin(phD)
+        z1 = two * rD * cD
+        z3 = -rD * (cD + s3 * sD)
+        zS = np.where(z1 + z3 > two * C, z1, z3)
+        xL, wL, xS, wS = yL - B, A, D, zS - C
+        E = wL * wS
+        F = -(wL * xS + xL * wS)
+        G = xL * xS
+        X3 = np.stack([xL, xS, C * F - B * G, y2 - B], axis=-1)
+        W3 = np.stack([wL, wS, C * E - B * F, A], axis=-1)
+        # disc < 0: Cardano in both forms plus the real parts of the complex pair
+        yA = _cardano_real(d1, QA, np.abs(A) * sq, dt)
+        zD = _cardano_real(d3, QD, np.abs(D) * sq, dt)
+        X1 = np.stack([yA - B, D, -half * yA - B, D], axis=-1)
+        W1 = np.stack([A, zD - C, A, -half * zD - C], axis=-1)
+        X = np.where(three_real[:, None], X3, X1).astype(dt)
+        W = np.where(three_real[:, None], W3, W1).astype(dt)
+        den = X + W
+        t = X / np.where(den != 0.0, den, dt(1.0))
+        valid = (den != 0.0) & (np.abs(t) < 1e30)
+        x = np.where(valid, np.clip(t, dt(0.0), dt(1.0)), dt(-1.0)).astype(dt)
+        c4 = cs[:, None, :]
+        ca4 = np.abs(c4)
+        kt = dt(root_tolerance_k(3)) * dt(EPS32)
+        acc = np.full(x.shape, 2.0, dtype=dt)
+        for it in range(polish + 1):
+            f, fp = _eval_deriv(c4, x, dt)
+            S, _ = _eval_deriv(ca4, x, dt)
+            acc = np.where(valid & (np.abs(f) <= kt * S), x, acc)  # a lane keeps its last passing iterate
+            if it < polish:
+                xn = x - f / np.where(fp != 0.0, fp, dt(1.0))
+                ok = valid & (fp != 0.0) & (np.abs(xn) < 1e30)
+                x = np.where(ok, np.clip(xn, dt(0.0), dt(1.0)), x).astype(dt)
+        best = np.min(acc, axis=-1)
+        res = np.where(best <= 1.0, best, np.nan)
+        res = np.where(cc[:, 0] == 0.0, 0.0, res)                  # if (c[0] == 0.0) return 0.0;
+        res = np.where(finite, res, np.nan)
+    return res.astype(dt).reshape(lead)
+
+
+def newton_three_starts(c, iterations: int = 5, *, dtype=np.float64):
+    """First root in [0, 1] of cubic BB polynomials by paper 003's Newton from three starts (NaN if none).
+
+    Mirrors ``sv_first_root_newton3`` in ``glsl/lib/roots.glsl`` line by line: ``iterations`` Newton steps
+    from ``0``, the inflection point ``w`` (root of ``f''``; ``1/2`` unless in (0, 1)) and ``1`` (paper 003,
+    sec. 5.3, ``I = 5``), then the smallest iterate in [0, 1] passing the residual test
+    ``|f(x)| <= K_3 EPS32 sum |c_k| B_k(x)`` of :func:`newton_secure`. A start with ``f' = 0`` or a
+    non-finite step keeps its ``x``; nothing is clamped. The zero polynomial gives 0.
+
+    Parameters
+    ----------
+    c : (..., 4) array_like
+        BB coefficients of degree 3.
+    iterations : int
+        1..8.
+    dtype : {numpy.float64, numpy.float32}
+    """
+    c = _check_univariate(c, high=3)
+    if c.shape[-1] != 4:
+        raise ValueError(f"newton_three_starts needs 4 coefficients (degree 3), got {c.shape[-1]}.")
+    if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 8:
+        raise ValueError(f"iterations must be an integer in 1..8; got {iterations!r}.")
+    dt = _check_dtype(dtype)
+    with np.errstate(all="ignore"):
+        cc = c.astype(dt)
+        w0, _ = _inflection_points(cc, dt)
+        w0 = np.where((w0 > 0.0) & (w0 < 1.0), w0, dt(0.5))          # if (!(w0 > 0 && w0 < 1)) w0 = 0.5;
+        x = np.stack([np.zeros_like(w0), w0, np.ones_like(w0), w0], axis=-1).astype(dt)
+        c4 = cc[..., None, :]
+        for _ in range(iterations):
+            f, fp = _eval_deriv(c4, x, dt)
+            nz = fp != 0.0
+            xn = x - f / np.where(nz, fp, dt(1.0))
+            x = np.where(nz & (np.abs(xn) < 1e30), xn, x).astype(dt)
+        f, _ = _eval_deriv(c4, x, dt)
+        S, _ = _eval_deriv(np.abs(c4), x, dt)
+        tol = dt(root_tolerance_k(3)) * dt(EPS32) * S
+        accept = (x >= 0.0) & (x <= 1.0) & (np.abs(f) <= tol)
+        best = np.min(np.where(accept, x, np.inf), axis=-1)
+    return np.where(np.isfinite(best), best, np.nan)

@@ -295,6 +295,18 @@ class SplineActor:
             pd.AddArray(vtk_arr)
         self.poly.Modified()
 
+    def set_triangles(self, triangles) -> None:
+        """Replace only the proxy triangles (indices into the current points): view-frustum culling."""
+        from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
+        from vtkmodules.vtkCommonDataModel import vtkCellArray
+
+        tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+        cells = vtkCellArray()
+        offsets = np.arange(0, 3 * len(tris) + 1, 3, dtype=np.int64)
+        cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(tris.ravel(), deep=True))
+        self.poly.SetPolys(cells)
+        self.poly.Modified()
+
     def set_texture(self, name: str, array: np.ndarray) -> None:
         """Replace one RGBA32F texture of the program (e.g. a coefficient table after an isovalue change)."""
         tex = _float_texture(array, name)

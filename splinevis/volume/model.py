@@ -49,7 +49,7 @@ def pad_linear(values: np.ndarray) -> np.ndarray:
     (corners too), in one allocation; keeps linear data linear (docs/volume-schemes.md, "Boundary")."""
     v = np.asarray(values, dtype=np.float64)
     nz, ny, nx = v.shape
-    P = np.empty((nz + 2, ny + 2, nx + 2))
+    P = np.zeros((nz + 2, ny + 2, nx + 2))  # borders are all overwritten; zeros keep garbage out of the arithmetic
     P[1:-1, 1:-1, 1:-1] = v
     for ax in range(3):
         Q = np.moveaxis(P, ax, 0)  # a view

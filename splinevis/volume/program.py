@@ -236,4 +236,7 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     if encoding == "coefficients":
         actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
     actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)
+    culler = getattr(actor, "culler", None)
+    if culler is not None:
+        culler.refresh()
     return rel
