@@ -254,3 +254,76 @@ def test_frustum_culling_draws_fewer_cubes_and_the_same_image():
     assert out[False][2] == out[False][3]
     assert out[True][2] < 0.7 * out[True][3]
     assert (out[True][1] < 1).sum() > 2000
+
+
+def _render_style_and_twin(iso, size=(160, 120), program_options=None, **style):
+    """Image of the isosurface with ``style`` and, per pixel, the float64 twin's hit points (NaN if none)."""
+    from splinevis.analysis.rays import pixel_rays
+    from splinevis.volume.raycast import raycast_isosurface
+
+    pl = splinevis.Plotter(off_screen=True, window_size=size)
+    pl.add_spline(iso, program_options=program_options, **style)
+    pl.camera_position = CAM
+    pl.reset_camera_clipping_range()
+    img = pl.screenshot().astype(np.float64) / 255.0
+    gpu_hit = pl.depth_buffer() < 1.0
+    o, d = pixel_rays(pl.camera_matrix(), *size)
+    pl.close()
+    t, _ = raycast_isosurface(iso, o.reshape(-1, 3), d.reshape(-1, 3))
+    p = (o.reshape(-1, 3) + t[:, None] * d.reshape(-1, 3)).reshape(o.shape)
+    return img, gpu_hit, p
+
+
+def _near_tet_face(spline, p, tol):
+    from splinevis.volume.partition import _locate
+
+    q = spline.grid.to_index(p)
+    local = q - (np.floor(q + 0.5) - 0.5)
+    _, lam = _locate(local)
+    return lam.min(axis=-1) < tol
+
+
+def test_curvature_output_matches_the_twin():
+    # Colours are 8-bit: |colour - expected| <= 1/255 (rounding) + 1/255 (float32 curvature and hit position
+    # within the depth bound, far below one colour step at this scale). The quadratic's Hessian is constant
+    # per tetrahedron, so hits within 1e-4 (barycentric) of a tetrahedron face may take the neighbour's
+    # value: those pixels are excluded.
+    s = VolumeSpline(sphere_grid(n=24))
+    scale = 3.0
+    img, gpu_hit, p = _render_style_and_twin(Isosurface(s, 0.7), output="curvature", curvature_scale=scale)
+    ok = gpu_hit & np.isfinite(p[..., 0])
+    keep = ok.copy()
+    keep[ok] = ~_near_tet_face(s, p[ok], 1e-4)
+    k = s.curvature(p[keep])[:, 0]
+    x = np.clip(k / scale, -1, 1)[:, None]
+    white = np.ones(3)
+    expected = np.where(x < 0, white + (np.array([0.23, 0.30, 0.75]) - white) * (-x),
+                        white + (np.array([0.71, 0.02, 0.15]) - white) * x)
+    err = np.abs(img[keep] - expected).max(axis=1)
+    assert keep.sum() > 3000
+    assert np.mean(err <= 2.0 / 255) >= 0.999, np.sort(err)[-5:]
+    # and the mean curvature of this sphere of radius 0.7 is 1/0.7 up to the scheme's O(h) error
+    assert abs(np.median(k) - 1 / 0.7) < 0.15
+
+
+def test_colour_by_a_second_field_matches_the_twin():
+    from splinevis.gl.inject import _colormap_image
+
+    g = sphere_grid(n=20)
+    x = np.linspace(-1, 1, 20)
+    zz = np.meshgrid(x, x, x, indexing="ij")[0]
+    field = 3.0 * zz + 1.0  # colour by height: linear, so every scheme reproduces it exactly
+    s = VolumeSpline(g)
+    img, gpu_hit, p = _render_style_and_twin(Isosurface(s, 0.7), program_options={"color_field": field},
+                                             colormap="viridis", lights=0)
+    ok = gpu_hit & np.isfinite(p[..., 0])
+    value = 3.0 * p[ok][:, 2] + 1.0
+    lut = _colormap_image("viridis").reshape(-1, _colormap_image("viridis").shape[-1])[:, :3] / 255.0
+    u = np.clip((value - field.min()) / (field.max() - field.min()), 0, 1) * 255.0
+    i0 = np.clip(np.floor(u).astype(int), 0, 254)
+    w = (u - i0)[:, None]
+    expected = (1 - w) * lut[i0] + w * lut[i0 + 1]
+    err = np.abs(img[ok] - expected).max(axis=1)
+    assert ok.sum() > 3000
+    # 1/255 rounding + the colour change over the depth bound's position error (< 1e-4 of the range here)
+    assert np.mean(err <= 2.0 / 255) >= 0.999, np.sort(err)[-5:]

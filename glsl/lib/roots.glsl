@@ -305,3 +305,178 @@ float sv_first_root_quadratic(float c[5]) {
     }
     return (best <= 1.0) ? best : -1.0;
 }
+
+// ------------------------------------------------------------------------------------------------------
+// Stable closed form for cubics (issue 4; paper 003, sec. 5.3: "well known formulae [HE95] ... in an
+// analytical and stable way").  The float64/float32 twin is splinevis.bb.roots.first_root_cubic.
+//
+// Homogeneous form.  With x = t, w = 1 - t the cubic BB polynomial is
+//     f = c3 x^3 + 3 c2 x^2 w + 3 c1 x w^2 + c0 w^3 =: A x^3 + 3 B x^2 w + 3 C x w^2 + D w^3,
+// i.e. the BB coefficients ARE the coefficients of the binary cubic (no conversion to the power basis,
+// whose leading coefficient c3 - 3 c2 + 3 c1 - c0 cancels).  A root (x : w) gives t = x / (x + w); t is in
+// [0, 1] iff x and w have the same sign, and then x + w does not cancel.  A root at t = 1 is w = 0, one at
+// t = infinity (power-form leading coefficient 0) is x = -w: neither is a special case here, so a
+// "degenerate leading coefficient" needs no fallback to sv_first_root_quadratic (the quadratic's roots
+// come out of the same formulas; measured in tests/test_roots_cubic.py).
+// Hessian d1 = AC - B^2, d2 = AD - BC, d3 = BD - C^2; discriminant disc = 4 d1 d3 - d2^2 (> 0: three real
+// roots, < 0: one).  Two depressed forms (Blinn, "How to solve a cubic equation", IEEE CG&A 2006/07):
+//   A-form: x = (y - B) / A with y^3 + 3 d1 y + (A d2 - 2 B d1) = 0   accurate for |x / w| large (t ~ 1),
+//   D-form: w = (z - C) / D with z^3 + 3 d3 z + (D d2 - 2 C d3) = 0   accurate for |x / w| small (t ~ 0);
+// their depressed discriminants are 4 (-d1)^3 - Q_A^2 = A^2 disc and 4 (-d3)^3 - Q_D^2 = D^2 disc, so
+// square roots of the (cancellation-prone) depressed discriminants are taken as |A| sqrt(|disc|).
+// * disc >= 0, trigonometric method: y_k = 2 sqrt(-d1) cos(phi + 2 pi k / 3), phi = atan(|A| sqrt(disc),
+//   -Q_A) / 3.  The A-form contributes the root with the largest |y - B| (no cancellation in y - B: the
+//   largest |x / w|), the D-form the one with the largest |z - C| (the smallest |x / w|); the third root is
+//   the cofactor of their quadratic factor E x^2 + F x w + G w^2: (x : w) = (C F - B G : C E - B F).  A
+//   fourth lane holds the A-form's middle root directly (redundant; whichever passes the test).
+// * disc < 0, Cardano without cancellation (sv_cardano_real): the real root in BOTH forms, and the real
+//   part -y/2 of the complex pair in both forms (a pair within rounding of the real axis is a touching /
+//   double root, i.e. a tangential ray: accepted by the residual test, not missed).
+// Scaling: the coefficients are multiplied by 2^-e, e = floor(log2 max |c_k|) (exact), so that the
+// products up to degree 4 (disc) neither overflow (|c| ~ 1e30) nor underflow for coefficients spanning
+// ~1e8 in magnitude.
+// Selection: the four candidates t (non-finite ones dropped, the others clamped to [0, 1]) are polished
+// by SV_CUBIC_POLISH Newton steps on the BB form (de Casteljau, vec4); every iterate is tested with the
+// residual test |f(x)| <= K_3 eps32 sum |c_k| B_k(x) of sv_first_root_newton4, a lane keeps its last
+// passing iterate, and the smallest accepted t wins.  The closed form alone leaves the candidates at
+// cond * eps32 (the transcendental functions add a few ulps); one Newton step brings simple roots to the
+// rounding level (measured: tests/test_roots_cubic.py, splinevis.volume.root_methods).
+// c0 = 0 (includes the zero polynomial) returns 0; non-finite coefficients return -1.0; -1.0 if no root.
+#ifndef SV_CUBIC_POLISH
+#define SV_CUBIC_POLISH 2
+#endif
+
+// Real root of y^3 + 3 P y + Q = 0 given R = sqrt(Q^2 + 4 P^3) >= 0 (one real root): u^3 = s is the root of
+// s^2 + Q s - P^3 = 0 of larger magnitude (no cancellation), v = -P / u, y = u + v; for P > 0 (u, v of
+// opposite signs) y = -Q / (u^2 + v^2 + P) instead, which has no cancellation either (y (y^2 + 3P) = -Q).
+float sv_cardano_real(float P, float Q, float R) {
+    float s = -0.5 * (Q + ((Q >= 0.0) ? R : -R));
+    float u = sign(s) * pow(abs(s), 1.0 / 3.0);
+    float v = (u != 0.0) ? -P / u : 0.0;
+    return (P > 0.0) ? -Q / (u * u + v * v + P) : u + v;
+}
+
+float sv_first_root_cubic(float c[5]) {
+    for (int k = 0; k < 4; ++k) {
+        if (!(abs(c[k]) <= 3.4028234663852886e38)) return -1.0;
+    }
+    if (c[0] == 0.0) return 0.0;
+    float m = max(max(abs(c[0]), abs(c[1])), max(abs(c[2]), abs(c[3])));
+    float sc = exp2(-clamp(floor(log2(m)), -126.0, 126.0));
+    float cs[5];
+    for (int k = 0; k < 4; ++k) cs[k] = c[k] * sc;
+    cs[4] = 0.0;
+    float A = cs[3];
+    float B = cs[2];
+    float C = cs[1];
+    float D = cs[0];
+    float d1 = A * C - B * B;
+    float d2 = A * D - B * C;
+    float d3 = B * D - C * C;
+    float disc = 4.0 * d1 * d3 - d2 * d2;
+    float QA = -2.0 * B * d1 + A * d2;
+    float QD = -2.0 * C * d3 + D * d2;
+    vec4 X;
+    vec4 W;
+    if (disc >= 0.0) {
+        float sq = sqrt(disc);
+        float phA = atan(abs(A) * sq, -QA) / 3.0;
+        float rA = sqrt(max(-d1, 0.0));
+        float cA = cos(phA);
+        float sA = sin(phA);
+        float y1 = 2.0 * rA * cA;
+        float y3 = -rA * (cA + 1.7320508 * sA);
+        float y2 = rA * (1.7320508 * sA - cA);
+        float yL = (y1 + y3 > 2.0 * B) ? y1 : y3;
+        float phD = atan(abs(D) * sq, -QD) / 3.0;
+        float rD = sqrt(max(-d3, 0.0));
+        float cD = cos(phD);
+        float sD = sin(phD);
+        float z1 = 2.0 * rD * cD;
+        float z3 = -rD * (cD + 1.7320508 * sD);
+        float zS = (z1 + z3 > 2.0 * C) ? z1 : z3;
+        float xL = yL - B;
+        float wL = A;
+        float xS = D;
+        float wS = zS - C;
+        float E = wL * wS;
+        float F = -(wL * xS + xL * wS);
+        float G = xL * xS;
+        X = vec4(xL, xS, C * F - B * G, y2 - B);
+        W = vec4(wL, wS, C * E - B * F, A);
+    } else {
+        float sq = sqrt(-disc);
+        float yA = sv_cardano_real(d1, QA, abs(A) * sq);
+        float zD = sv_cardano_real(d3, QD, abs(D) * sq);
+        X = vec4(yA - B, D, -0.5 * yA - B, D);
+        W = vec4(A, zD - C, A, -0.5 * zD - C);
+    }
+    vec4 den = X + W;
+    vec4 x;
+    bvec4 valid;
+    for (int i = 0; i < 4; ++i) {
+        float t = X[i] / ((den[i] != 0.0) ? den[i] : 1.0);
+        valid[i] = den[i] != 0.0 && abs(t) < 1e30;
+        x[i] = valid[i] ? clamp(t, 0.0, 1.0) : -1.0;
+    }
+    float ca[5];
+    for (int k = 0; k < 5; ++k) ca[k] = abs(cs[k]);
+    vec4 acc = vec4(2.0);
+    for (int it = 0; it <= SV_CUBIC_POLISH; ++it) {
+        vec4 f;
+        vec4 fp;
+        vec4 S;
+        vec4 dummy;
+        sv_bernstein_eval_deriv4(cs, 3, x, f, fp);
+        sv_bernstein_eval_deriv4(ca, 3, x, S, dummy);
+        vec4 tol = sv_root_tol_k(3) * SV_ROOT_EPS32 * S;
+        for (int i = 0; i < 4; ++i) {
+            if (valid[i] && abs(f[i]) <= tol[i]) acc[i] = x[i];
+            if (it < SV_CUBIC_POLISH) {
+                float xn = x[i] - f[i] / ((fp[i] != 0.0) ? fp[i] : 1.0);
+                if (valid[i] && fp[i] != 0.0 && abs(xn) < 1e30) x[i] = clamp(xn, 0.0, 1.0);
+            }
+        }
+    }
+    float best = min(min(acc.x, acc.y), min(acc.z, acc.w));
+    return (best <= 1.0) ? best : -1.0;
+}
+
+// ------------------------------------------------------------------------------------------------------
+// Paper 003's method (sec. 5.3): Newton's method from the three starting values 0, the inflection point
+// w of the cubic (the root of f'', w = 1/2 if there is none in (0, 1)) and 1, with a fixed number of
+// iterations (the paper: I = 5).  Same residual acceptance, no clamping and the same guards as
+// sv_first_root_newton4 (the paper gives no acceptance rule; a returned iterate must pass
+// |f(x)| <= K_3 eps32 sum |c_k| B_k(x)).  The fourth vec4 lane repeats the start w (no effect on the
+// result).  The twin is splinevis.bb.roots.newton_three_starts.  iterations in 1..8; -1.0 if no root.
+float sv_first_root_newton3(float c[5], int iterations) {
+    float w0;
+    float w1;
+    sv_inflection_points(c, 3, w0, w1);
+    if (!(w0 > 0.0 && w0 < 1.0)) w0 = 0.5;
+    vec4 x = vec4(0.0, w0, 1.0, w0);
+    vec4 f;
+    vec4 fp;
+    for (int it = 0; it < 8; ++it) {
+        if (it < iterations) {
+            sv_bernstein_eval_deriv4(c, 3, x, f, fp);
+            bvec4 nz = notEqual(fp, vec4(0.0));
+            vec4 xn = x - f / mix(vec4(1.0), fp, nz);
+            bvec4 ok = bvec4(nz.x && abs(xn.x) < 1e30, nz.y && abs(xn.y) < 1e30,
+                             nz.z && abs(xn.z) < 1e30, nz.w && abs(xn.w) < 1e30);
+            x = mix(x, xn, ok);
+        }
+    }
+    float ca[5];
+    for (int k = 0; k < 5; ++k) ca[k] = abs(c[k]);
+    vec4 S;
+    vec4 dummy;
+    sv_bernstein_eval_deriv4(c, 3, x, f, fp);
+    sv_bernstein_eval_deriv4(ca, 3, x, S, dummy);
+    vec4 tol = sv_root_tol_k(3) * SV_ROOT_EPS32 * S;
+    float best = 2.0;
+    for (int i = 0; i < 4; ++i) {
+        if (x[i] >= 0.0 && x[i] <= 1.0 && abs(f[i]) <= tol[i]) best = min(best, x[i]);
+    }
+    return (best <= 1.0) ? best : -1.0;
+}

@@ -36,6 +36,16 @@ uniform int sv_tex_width;         // texels per row of the data / coefficient te
 uniform vec3 sv_padded_dims;      // (nx + 2, ny + 2, nz + 2)
 uniform vec3 sv_cube_count;       // (nx, ny, nz): hit.uv = (x, y) / (nx, ny)
 
+#ifdef SV_VOLUME_COLOR_FIELD
+// A second field on the same grid (the sampler sv_color_data, same layout as sv_volume_data): the
+// isosurface is coloured by its spline (same scheme) at the hit; hit.scalar feeds the colormap effect.
+float sv_fetch_color(int n) {
+    int texel = n / 4;
+    vec4 v = texelFetch(sv_color_data, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+    return v[n - 4 * texel];
+}
+#endif
+
 float sv_fetch_linear(int n) {
     int texel = n / 4;
 #ifdef SV_VOLUME_TABLE
@@ -59,22 +69,31 @@ void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
 }
 #endif
 
-// The cube's 27 data values (padded volume, x fastest), stencil order of splinevis.volume.schemes.STENCIL.
-void sv_load_stencil(ivec3 c, out float f[27]) {
-#ifdef SV_VOLUME_TABLE
-    for (int s = 0; s < 27; ++s) f[s] = 0.0;
-#else
+// The cube's 27 data values (padded volume, x fastest), stencil order of splinevis.volume.schemes.STENCIL;
+// field 0 = the volume, field 1 = the colour field.
+void sv_load_stencil_of(ivec3 c, int field, out float f[27]) {
     ivec3 dims = ivec3(sv_padded_dims + 0.5);
     int s = 0;
     for (int dz = 0; dz < 3; ++dz) {
         for (int dy = 0; dy < 3; ++dy) {
             int row = ((c.z + dz) * dims.y + (c.y + dy)) * dims.x + c.x;
             for (int dx = 0; dx < 3; ++dx) {
+#ifdef SV_VOLUME_COLOR_FIELD
+                f[s] = (field == 0) ? sv_fetch_linear(row + dx) : sv_fetch_color(row + dx);
+#else
                 f[s] = sv_fetch_linear(row + dx);
+#endif
                 s += 1;
             }
         }
     }
+}
+
+void sv_load_stencil(ivec3 c, out float f[27]) {
+#ifdef SV_VOLUME_TABLE
+    for (int s = 0; s < 27; ++s) f[s] = 0.0;
+#else
+    sv_load_stencil_of(c, 0, f);
 #endif
 }
 
@@ -109,6 +128,35 @@ vec3 sv_tet_gradient(float b[SV_VOL_NCOEF], int t, vec4 l, out float value) {
     for (int i = 0; i < 4; ++i) g += a[i] * SV_TET_BARY[4 * t + i].xyz;
     return float(SV_VOL_DEGREE) * g;
 }
+
+#ifdef SV_OUT_CURVATURE
+// Mean and Gaussian curvature of the level set at barycentric point l of tetrahedron t, from the gradient g
+// and Hessian H (model coordinates): H from the degree-2 blossom a2 of the polynomial at l,
+// H = n (n - 1) G^T A G with A_ij = a2[e_i + e_j] and G_i = grad lam_i, scaled by 1 / spacing per axis.
+// mean = (|g|^2 tr H - g^T H g) / (2 |g|^3), gauss = g^T adj(H) g / |g|^4 (Goldman, CAGD 22 (2005)):
+// 1/r and 1/r^2 for a sphere of radius r of a field increasing outwards. Twin: VolumeSpline.curvature.
+vec2 sv_tet_curvature(float b[SV_VOL_NCOEF], int t, vec4 l, vec3 g) {
+    float a2[10];
+#ifdef SV_VOLUME_CUBIC
+    sv_tet_step3(b, l, a2);
+#else
+    for (int q = 0; q < 10; ++q) a2[q] = b[q];
+#endif
+    // multi_indices(2, 3) order: 2000 1100 1010 1001 0200 0110 0101 0020 0011 0002
+    mat4 A = mat4(a2[0], a2[1], a2[2], a2[3],
+                  a2[1], a2[4], a2[5], a2[6],
+                  a2[2], a2[5], a2[7], a2[8],
+                  a2[3], a2[6], a2[8], a2[9]);
+    mat4x3 G;  // column i = grad lam_i (model coordinates)
+    for (int i = 0; i < 4; ++i) G[i] = SV_TET_BARY[4 * t + i].xyz * sv_inv_spacing;
+    mat3 H = float(SV_VOL_DEGREE * (SV_VOL_DEGREE - 1)) * (G * A * transpose(G));
+    float gg = dot(g, g);
+    float mean = (gg * (H[0][0] + H[1][1] + H[2][2]) - dot(g, H * g)) / (2.0 * gg * sqrt(gg));
+    mat3 adj = transpose(mat3(cross(H[1], H[2]), cross(H[2], H[0]), cross(H[0], H[1])));
+    float gauss = dot(g, adj * g) / (gg * gg);
+    return vec2(mean, gauss);
+}
+#endif
 
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.curvature = vec2(0.0);
@@ -175,6 +223,18 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.pos = ro + t_best * rd;
     hit.normal = g * sv_inv_spacing;   // chain rule: d/dx_model = d/dx_local * (1 / spacing)
     hit.scalar = value + sv_value_ref;
-    hit.uv = (vec2(c.xy) + P.xy - 0.5 + 0.5) / sv_cube_count.xy;
+#ifdef SV_VOLUME_COLOR_FIELD
+    float f2[27];
+    float b2[SV_VOL_NCOEF];
+    sv_load_stencil_of(c, 1, f2);
+    sv_tet_coefficients(tet_best, f2, b2);
+    float value2;
+    vec3 g2 = sv_tet_gradient(b2, tet_best, l, value2);
+    hit.scalar = value2;
+#endif
+#ifdef SV_OUT_CURVATURE
+    hit.curvature = sv_tet_curvature(b, tet_best, l, hit.normal);
+#endif
+    hit.uv = (vec2(c.xy) + P.xy) / sv_cube_count.xy;
     return true;
 }

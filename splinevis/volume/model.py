@@ -209,6 +209,36 @@ class VolumeSpline:
         grad_local = np.einsum("ni,nij->nj", dlam, _bary_mats()[t][..., :3])
         return val, grad_local / self.spacing
 
+    def curvature(self, points) -> np.ndarray:
+        """(n, 2) mean and Gaussian curvature of the level sets through world points (float64 twin of the
+        shader's ``sv_tet_curvature``): mean = (|g|^2 tr H - g^T H g) / (2 |g|^3), gauss = g^T adj(H) g / |g|^4
+        with g, H the spline's gradient and Hessian (1/r and 1/r^2 on a sphere of a field increasing
+        outwards)."""
+        cell, t, lam = self._locate(points)
+        uc, inv = np.unique(cell, axis=0, return_inverse=True)
+        coef = self.cube_coefficients(uc)[inv.ravel(), t]
+        n = self.degree
+        g = bb.gradient(coef, d=3)
+        dlam = bb._decasteljau(g, n - 1, 3, lam[:, None, :])
+        G = _bary_mats()[t][..., :3] / self.spacing  # (n, 4, 3): grad lam_i, model = world coordinates
+        grad = np.einsum("ni,nij->nj", dlam, G)
+        a2 = coef if n == 2 else bb._decasteljau(_second_blossom(coef), 1, 3, lam[:, None, :])
+        idx = bb.index_of(2, 3)
+        A = np.empty((len(coef), 4, 4))
+        for i in range(4):
+            for j in range(4):
+                e = [0, 0, 0, 0]
+                e[i] += 1
+                e[j] += 1
+                A[:, i, j] = a2[:, idx[tuple(e)]]
+        H = n * (n - 1) * np.einsum("nia,nij,njb->nab", G, A, G)
+        gg = np.einsum("ni,ni->n", grad, grad)
+        mean = (gg * np.trace(H, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", grad, H, grad)) / (2 * gg ** 1.5)
+        adj = np.stack([np.cross(H[:, :, 1], H[:, :, 2]), np.cross(H[:, :, 2], H[:, :, 0]),
+                        np.cross(H[:, :, 0], H[:, :, 1])], axis=1)  # rows of the adjugate (H symmetric)
+        gauss = np.einsum("ni,nij,nj->n", grad, adj, grad) / gg ** 2
+        return np.column_stack([mean, gauss])
+
     # ------------------------------------------------------------------ isovalue-independent structure
     def cube_ranges(self) -> tuple:
         """Per-cube ``(lo, hi)`` float32 bounds of the cube's BB coefficients (rounded outward), from the min
@@ -279,6 +309,20 @@ class VolumeSpline:
         nz, ny, nx = self.shape
         return (f"VolumeSpline({self.scheme}, {nx}x{ny}x{nz} cubes, spacing={self.grid.spacing}, origin={self.grid.origin}, "
                 f"source={self.grid.source!r})")
+
+
+def _second_blossom(coef: np.ndarray) -> np.ndarray:
+    """(n, 10, 4) cubic -> for each quadratic multi-index a, the 4 coefficients c[a + e_k] (one de Casteljau
+    step at lam is then ``sum_k lam_k c[a + e_k]``), so that ``_decasteljau(., 1, 3, lam)`` gives the
+    degree-2 blossom a2 of the cubic at lam."""
+    i3, i2 = bb.index_of(3, 3), bb.index_of(2, 3)
+    out = np.empty(coef.shape[:-1] + (10, 4))
+    for a, q in i2.items():
+        for k in range(4):
+            e = list(a)
+            e[k] += 1
+            out[..., q, k] = coef[..., i3[tuple(e)]]
+    return out
 
 
 def _box3(P: np.ndarray, op) -> np.ndarray:

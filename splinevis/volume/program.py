@@ -134,7 +134,7 @@ def memory_report(spline: VolumeSpline, relevant: Relevant) -> dict:
 
 
 def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encoding: str = "data",
-                       roots: str | None = None) -> ProgramSpec:
+                       roots: str | None = None, color_field=None) -> ProgramSpec:
     """Describe the ray-cast program of an isosurface.
 
     Parameters
@@ -148,6 +148,9 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         Quadratic default ``"analytic"`` (stable closed form); cubic default ``"bracketed"`` (bracketed Newton
         on convex pieces); ``"paper"``: Newton from the secure starts 0, inflection point(s), 1 with a fixed
         iteration count (paper 003 sec. 5.3; the shared implementation adds a fourth start at 2/3).
+    color_field : array-like (nz, ny, nx) or VolumeGrid, optional
+        A second field on the same grid; the surface is coloured by its spline (same scheme) at the hit
+        through the Style's colormap (``scalar_range`` defaults to the field's range).
     """
     if not isinstance(model, Isosurface):
         raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")
@@ -170,6 +173,18 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     else:
         textures["sv_volume_coef"] = coefficient_table(spline, rel)[0]
     nz, ny, nx = spline.shape
+    scalar_range = spline.value_range
+    if color_field is not None:
+        values = np.asarray(getattr(color_field, "values", color_field), dtype=np.float64)
+        if values.shape != spline.shape:
+            raise ValueError(f"color_field must have the volume's shape (nz, ny, nx) = {spline.shape}, got {values.shape}.")
+        if not np.isfinite(values).all():
+            k, j, i = (int(v) for v in np.argwhere(~np.isfinite(values))[0])
+            raise ValueError(f"color_field has a non-finite value at voxel [k, j, i] = [{k}, {j}, {i}].")
+        from .model import pad_linear
+
+        textures["sv_color_data"] = _linear_texture(pad_linear(values))
+        scalar_range = (float(values.min()), float(values.max()))
     return ProgramSpec(
         name="isosurface",
         entry="programs/isosurface.glsl",
@@ -177,6 +192,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         triangles=tris,
         offset=tuple(spline.origin),
         defines={"SV_VOLUME_CUBIC": cubic, "SV_VOLUME_TABLE": encoding == "coefficients",
+                 "SV_VOLUME_COLOR_FIELD": color_field is not None,
                  "SV_ROOTS_PAPER_NEWTON": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
         uniforms={
             "sv_inv_spacing": tuple(1.0 / spline.spacing),
@@ -188,7 +204,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
             "sv_tex_width": TEXTURE_WIDTH,
             "sv_padded_dims": (float(nx + 2), float(ny + 2), float(nz + 2)),
             "sv_cube_count": (float(nx), float(ny), float(nz)),
-            "sv_scalar_range": spline.value_range,
+            "sv_scalar_range": scalar_range,
         },
         textures=textures,
         attributes=attributes,
