@@ -18,6 +18,7 @@ texture         base colour from an RGB(A) image draped by the surface's (u, v)
 environment     reflection of a latitude-longitude environment image
 reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray
 isophotes       stripes of constant ``dot(n, L)``
+transparency    ``opacity < 1``: alpha output, composited by VTK's translucent pass
 normals         output colour = encoded unit normal ``0.5 * (n + 1)`` (replaces shading)
 curvature       output colour = mean curvature through a diverging colormap (replaces shading)
 depth           output colour = window depth in the red channel (replaces shading)
@@ -48,6 +49,7 @@ EFFECTS: dict[str, tuple[str, str]] = {
     "environment": ("SV_ENVIRONMENT", "lib/effects/environment.glsl"),
     "reflection_lines": ("SV_REFLECTION_LINES", "lib/effects/reflection_lines.glsl"),
     "isophotes": ("SV_ISOPHOTES", "lib/effects/isophotes.glsl"),
+    "transparency": ("SV_TRANSPARENCY", "lib/effects/transparency.glsl"),
     "normals": ("SV_OUT_NORMALS", "lib/effects/normals.glsl"),
     "curvature": ("SV_OUT_CURVATURE", "lib/effects/curvature.glsl"),
     "depth": ("SV_OUT_DEPTH", "lib/effects/depth.glsl"),
@@ -106,6 +108,10 @@ class Style:
         Lighting parameters (uniforms; changing them does not recompile).
     curvature_scale : float, default 1.0
         Mean curvature shown at full colour by ``output="curvature"`` (a uniform).
+    opacity : float in (0, 1], default 1.0
+        Below 1 the surface is drawn translucent over opaque meshes (effect ``transparency``: the alpha
+        output is compiled in and VTK's translucent pass composites it). Every sheet a ray crosses is
+        composited (for an isosurface: one per cube the ray crosses), so back sheets show through.
 
     Examples
     --------
@@ -132,6 +138,7 @@ class Style:
     diffuse: float = 0.85
     specular_power: float = 40.0
     curvature_scale: float = 1.0
+    opacity: float = 1.0
 
     def __post_init__(self):
         if isinstance(self.lights, bool) or not isinstance(self.lights, (int, np.integer)) or not 0 <= self.lights <= MAX_LIGHTS:
@@ -170,6 +177,8 @@ class Style:
             raise ValueError("Style.isophotes are bands of dot(n, L) for the first light: set lights >= 1.")
         if self.output is not None:
             check_choice(self.output, "Style.output", OUTPUT_MODES)
+        if isinstance(self.opacity, bool) or not isinstance(self.opacity, (int, float, np.floating)) or not 0 < self.opacity <= 1:
+            raise ValueError(f"Style.opacity must be a number in (0, 1], got {self.opacity!r}.")
 
     # -- code -----------------------------------------------------------------------------------------
     def effect_set(self) -> frozenset:
@@ -190,6 +199,8 @@ class Style:
         for name in ("texture", "environment", "reflection_lines", "isophotes"):
             if getattr(self, name) is not None:
                 on.add(name)
+        if self.opacity < 1:
+            on.add("transparency")
         if self.output is not None:
             on.add(self.output)
         return frozenset(on)
@@ -230,6 +241,8 @@ class Style:
             u["sv_scalar_range"] = tuple(float(v) for v in self.scalar_range)
         if self.output == "curvature":
             u["sv_curvature_scale"] = float(self.curvature_scale)
+        if self.opacity < 1:
+            u["sv_opacity"] = float(self.opacity)
         return u
 
     def replace(self, **changes) -> "Style":

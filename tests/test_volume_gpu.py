@@ -327,3 +327,37 @@ def test_colour_by_a_second_field_matches_the_twin():
     assert ok.sum() > 3000
     # 1/255 rounding + the colour change over the depth bound's position error (< 1e-4 of the range here)
     assert np.mean(err <= 2.0 / 255) >= 0.999, np.sort(err)[-5:]
+
+
+def test_translucent_isosurface_over_opaque_meshes():
+    # A translucent isosurface shows every sheet a ray crosses (each cube's fragment draws its own first hit;
+    # VTK's translucent pass does not write depth). With a single sheet -- a tilted plane -- one layer is
+    # composited: C = alpha S + (1 - alpha) B, with S the opaque surface's colour and B the scene without it.
+    # Tolerance: 1/255 rounding of each of the three images plus 1/255 for the translucent pass's
+    # half-float accumulation.
+    import pyvista as pv
+
+    alpha = 0.4
+    x = np.linspace(-1, 1, 16)
+    zz, yy, xx = np.meshgrid(x, x, x, indexing="ij")
+    grid = VolumeGrid(xx + 0.3 * yy, spacing=(2 / 15,) * 3, origin=(-1, -1, -1))
+
+    def scene(opacity):
+        pl = splinevis.Plotter(off_screen=True, window_size=(200, 150))
+        if opacity is not None:
+            pl.add_isosurface(grid, 0.1, lights=1, opacity=opacity, color="gold", culling=False)
+        pl.add_mesh(pv.Cylinder(center=(-0.5, 0, 0), radius=0.25, height=2.4, direction=(0, 0, 1)), color="steelblue")
+        pl.add_mesh(pv.Cube(center=(1.2, 0.3, 0.0), x_length=0.4, y_length=0.4, z_length=0.4), color="red")
+        pl.camera_position = [(3, 2, 1.5), (0, 0, 0), (0, 0, 1)]
+        pl.camera.clipping_range = (0.5, 10.0)
+        img = pl.screenshot().astype(np.float64)
+        pl.close()
+        return img
+
+    A, B, C = scene(1.0), scene(None), scene(alpha)
+    surface = np.abs(A - B).max(axis=2) > 8  # pixels where the opaque surface shows
+    assert surface.sum() > 3000
+    err = np.abs(C - (alpha * A + (1 - alpha) * B))[surface].max(axis=1)
+    assert np.mean(err <= 3.0) >= 0.999, np.sort(err)[-5:]
+    hidden = ~surface
+    assert np.abs(C - B)[hidden].max() <= 3.0  # where a mesh occludes the surface (or it is absent) nothing changes

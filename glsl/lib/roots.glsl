@@ -429,7 +429,7 @@ float sv_first_root_cubic(float c[5]) {
         vec4 dummy;
         sv_bernstein_eval_deriv4(cs, 3, x, f, fp);
         sv_bernstein_eval_deriv4(ca, 3, x, S, dummy);
-        vec4 tol = sv_root_tol_k(3) * SV_ROOT_EPS32 * S;
+        vec4 tol = sv_root_tol_k(3) * SV_ROOT_EPS32 * S + SV_ROOT_EPS32 * abs(x * fp);
         for (int i = 0; i < 4; ++i) {
             if (valid[i] && abs(f[i]) <= tol[i]) acc[i] = x[i];
             if (it < SV_CUBIC_POLISH) {

@@ -32,6 +32,10 @@ vec4 sv_shade(SvHit h, vec3 rd) {
 #ifdef SV_ISOPHOTES
     col *= sv_isophotes(n);
 #endif
+#ifdef SV_TRANSPARENCY
+    return vec4(col, sv_opacity);
+#else
     return vec4(col, 1.0);
+#endif
 #endif
 }

@@ -757,7 +757,8 @@ def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
         for it in range(polish + 1):
             f, fp = _eval_deriv(c4, x, dt)
             S, _ = _eval_deriv(ca4, x, dt)
-            acc = np.where(valid & (np.abs(f) <= kt * S), x, acc)  # a lane keeps its last passing iterate
+            tol = kt * S + dt(EPS32) * np.abs(x * fp)                # ... * S + SV_ROOT_EPS32 * abs(x * fp)
+            acc = np.where(valid & (np.abs(f) <= tol), x, acc)  # a lane keeps its last passing iterate
             if it < polish:
                 xn = x - f / np.where(fp != 0.0, fp, dt(1.0))
                 ok = valid & (fp != 0.0) & (np.abs(xn) < 1e30)

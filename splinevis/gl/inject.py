@@ -236,6 +236,8 @@ class SplineActor:
         prop = actor.GetProperty()
         if cull_front:
             prop.FrontfaceCullingOn()
+        if style.opacity < 1:
+            prop.SetOpacity(float(style.opacity))
         sp = actor.GetShaderProperty()
         sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
         sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -588,7 +589,10 @@ def side_by_side_figure(path, *, n=41, cubic=True, window=(420, 330)):
 def _markdown(result) -> str:
     md = ["# Volume study: what accuracy costs in time (issue 4, paper 003)\n",
           f"Mode: {'quick' if result['quick'] else 'full'}; {result['cubic']['note']}; "
-          f"{result['seconds']:.0f} s. All numbers measured in this run on Mesa llvmpipe (2 CPU cores, no GPU) "
+          f"{result['seconds']:.0f} s; load average (1/5/15 min) at start "
+          f"{'/'.join(f'{v:.1f}' for v in result.get('machine', {}).get('loadavg_1_5_15_at_start', []))}, at end "
+          f"{'/'.join(f'{v:.1f}' for v in result.get('machine', {}).get('loadavg_1_5_15_at_end', []))} "
+          "(frame times are wall-clock on a shared 2-core machine). All numbers measured in this run on Mesa llvmpipe (2 CPU cores, no GPU) "
           "unless the column or table says \"paper\".\n"]
     md.append("## 1. Approximation (max errors over 20,000 random interior points; order = observed vs previous size)\n")
     md.append(_md_table(result["approximation"], [
@@ -648,7 +652,8 @@ def run_volume_study(out_dir, *, quick=False, progress=True) -> dict:
     cubic, note = cubic_status()
     _log(note)
     schemes = ("trilinear", "quadratic", "cubic") if cubic else ("trilinear", "quadratic")
-    result = {"quick": quick, "cubic": {"available": cubic, "note": note}}
+    result = {"quick": quick, "cubic": {"available": cubic, "note": note},
+              "machine": {"loadavg_1_5_15_at_start": list(os.getloadavg())}}
     result["approximation"] = approximation_rows(sizes=(16, 32, 64) if quick else (16, 32, 64, 128), schemes=schemes,
                                                  progress=progress)
     approximation_figure(result["approximation"], out / "approximation.png")
@@ -663,6 +668,7 @@ def run_volume_study(out_dir, *, quick=False, progress=True) -> dict:
     result["paper_table_1"] = PAPER_TABLE_1
     result["side_by_side_coverage"] = side_by_side_figure(out / "side_by_side.png", n=41, cubic=cubic)
     result["seconds"] = time.perf_counter() - t_start
+    result["machine"]["loadavg_1_5_15_at_end"] = list(os.getloadavg())
     result = _clean(result)
     (out / "volume.md").write_text(_markdown(result))
     (out / "volume.json").write_text(json.dumps(result, indent=2, allow_nan=False))
