@@ -9,8 +9,8 @@ Writes, under glsl/lib/:
   restriction of a quadratic or cubic to a segment by blossoming (paper 003, sec. 5.3, Fig. 10);
 * ``volume_stencil_<scheme>.glsl`` -- ``sv_tet_coefficients(t, f, b)``: the BB coefficients of
   tetrahedron t of a cube from the cube's 27 data values (the scheme's averaging rules, paper 003 sec. 4
-  eq. (3) and Fig. 7, as the fixed weights of splinevis.volume.schemes.tet_weights), one ``case`` per
-  tetrahedron with its weights grouped by value.
+  eq. (3) and Fig. 7, as the fixed weights of splinevis.volume.schemes.tet_weights): tetrahedron 0's rules,
+  weights grouped by value, applied to the data permuted by the cube symmetry taking tetrahedron 0 to t.
 
 Run ``python tools/gen_volume_glsl.py`` after changing a scheme; tests/test_volume_gpu.py checks the files
 are current.
@@ -101,38 +101,78 @@ void sv_restrict_tet3(float b[20], vec4 l0, vec4 l1, out float c[5]) {
     return HEAD + doc + body + restrict
 
 
+def _symmetries():
+    """The 48 symmetries of the cube about its centre as (3, 3) signed permutation matrices."""
+    import itertools
+
+    out = []
+    for perm in itertools.permutations(range(3)):
+        for signs in itertools.product((1, -1), repeat=3):
+            m = np.zeros((3, 3), dtype=np.int64)
+            for r in range(3):
+                m[r, perm[r]] = signs[r]
+            out.append(m)
+    return out
+
+
+def stencil_permutations(W: np.ndarray) -> np.ndarray:
+    """(24, 27) int: for tetrahedron t, the symmetry sigma_t of the cube mapping tetrahedron 0's vertices
+    [vQ, wF, u, u'] in order onto tetrahedron t's, as a permutation of the 27 stencil offsets, such that
+    ``W[t, q, perm[t, s]] == W[0, q, s]``: the scheme is symmetric, so tetrahedron t's coefficients are
+    tetrahedron 0's rules applied to the permuted data (paper 003 sec. 5.2: "by symmetry of D_q, we do not
+    have different cases for differing tetrahedra"). Raises if the weights are not symmetric."""
+    from splinevis.volume.partition import type6_tetrahedra
+    from splinevis.volume.schemes import STENCIL
+
+    V = type6_tetrahedra() - 0.5  # about the cube centre
+    index = {tuple(int(v) for v in o): k for k, o in enumerate(STENCIL)}
+    perms = np.empty((24, 27), dtype=np.int64)
+    for t in range(24):
+        for m in _symmetries():
+            if np.allclose(V[0] @ m.T, V[t]):
+                perm = np.array([index[tuple(int(v) for v in m @ o)] for o in STENCIL])
+                if not np.allclose(W[t][:, perm], W[0], atol=1e-15):
+                    raise ValueError(f"weights of tetrahedron {t} are not the symmetric image of tetrahedron 0's.")
+                perms[t] = perm
+                break
+        else:
+            raise ValueError(f"no cube symmetry maps tetrahedron 0 onto tetrahedron {t} in vertex order.")
+    return perms
+
+
 def stencil(scheme: str) -> str:
     W = tet_weights(scheme)  # (24, m, 27)
     n = SCHEME_DEGREE[scheme]
     m = W.shape[1]
+    perms = stencil_permutations(W)
+    table = ", ".join(str(int(v)) for v in perms.ravel())
     out = [HEAD, f"// BB coefficients of the {scheme} scheme on tetrahedron t of a cube from the cube's 27 data values\n"
            "// f[s] at offsets splinevis.volume.schemes.STENCIL[s] (x fastest); paper 003 sec. 4, eq. (3), Fig. 7.\n"
-           f"const int SV_VOL_DEGREE = {n};\nconst int SV_VOL_NCOEF = {m};\n\n",
-           f"void sv_tet_coefficients(int t, float f[27], out float b[{m}]) {{\n    switch (t) {{\n"]
-    for t in range(24):
-        out.append(f"    case {t}:\n")
-        for q in range(m):
-            w = W[t, q]
-            groups: dict = {}
-            for s in np.nonzero(np.abs(w) > 0)[0]:
-                groups.setdefault(float(w[s]), []).append(int(s))
-            parts = []
-            for val, ss in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
-                s_sum = " + ".join(f"f[{s}]" for s in ss)
-                parts.append(f"{_f(val)} * ({s_sum})" if len(ss) > 1 else f"{_f(val)} * {s_sum}")
-            out.append(f"        b[{q}] = " + " + ".join(parts) + ";\n")
-        out.append("        break;\n")
-    out.append("    }\n}\n")
+           "// The scheme is symmetric: tetrahedron t applies tetrahedron 0's rules to the data permuted by the cube\n"
+           "// symmetry sigma_t mapping tetrahedron 0 onto t (one code path for all 24; a switch over 24 cases cost\n"
+           "// three times the frame time of the cubic on llvmpipe).\n"
+           f"const int SV_VOL_DEGREE = {n};\nconst int SV_VOL_NCOEF = {m};\n"
+           f"const int SV_STENCIL_PERM[648] = int[648]({table});\n\n",
+           f"void sv_tet_coefficients(int t, float f[27], out float b[{m}]) {{\n    float g[27];\n"
+           "    for (int s = 0; s < 27; ++s) g[s] = f[SV_STENCIL_PERM[27 * t + s]];\n"]
+    for q in range(m):
+        w = W[0, q]
+        groups: dict = {}
+        for s in np.nonzero(np.abs(w) > 0)[0]:
+            groups.setdefault(float(w[s]), []).append(int(s))
+        parts = []
+        for val, ss in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
+            s_sum = " + ".join(f"g[{s}]" for s in ss)
+            parts.append(f"{_f(val)} * ({s_sum})" if len(ss) > 1 else f"{_f(val)} * {s_sum}")
+        out.append(f"    b[{q}] = " + " + ".join(parts) + ";\n")
+    out.append("}\n")
     return "".join(out)
 
 
 def generate() -> dict:
     files = {"type6.glsl": type6(), "tet_steps.glsl": tet_steps()}
     for scheme in SCHEME_DEGREE:
-        try:
-            files[f"volume_stencil_{scheme}.glsl"] = stencil(scheme)
-        except NotImplementedError:
-            pass
+        files[f"volume_stencil_{scheme}.glsl"] = stencil(scheme)
     return files
 
 
