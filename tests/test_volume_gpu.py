@@ -78,21 +78,22 @@ def test_generated_glsl_is_current():
 CAM = [(3.0, 2.0, 2.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
 
 
-@pytest.mark.parametrize("options", [{}, {"encoding": "coefficients"}, {"roots": "bracketed"}],
-                         ids=["data-analytic", "table", "bracketed"])
+@pytest.mark.parametrize("options", [{}, {"encoding": "coefficients"}, {"roots": "bracketed"}, {"proxy": "cubes"},
+                                     {"proxy": "cubes", "encoding": "coefficients"}, {"block_size": 3}],
+                         ids=["blocks-data-analytic", "blocks-table", "bracketed", "cubes", "cubes-table", "blocks-of-3"])
 def test_quadratic_sphere_matches_twin(options):
     iso = Isosurface(VolumeSpline(sphere_grid()), 0.7)
     check(agreement(iso, CAM, options=options))
 
 
 def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
-    # Paper 003's fixed-iteration Newton from secure starts (here 0, 1/3, 2/3, 1 for a quadratic) has no
+    # Paper 003's fixed-iteration Newton from three starts (0, the inflection point or 1/2, 1) has no
     # bracket: a start that has not converged fails the residual test, and the smallest ACCEPTED iterate can
-    # be a later root (measured ~1.4 % of the pixels of this view, whatever the iteration count) or none.
+    # be a later root or none (roots near s = 1 are overshot: splinevis.volume.root_methods measures it).
     # It stays selectable so the study can measure it. What must hold: it never reports a hit in front of
     # the true surface or where there is none, and it is right (within the bound) on almost all pixels;
     # the 5 % ceiling is a regression guard on a measured rate, not a derived tolerance.
-    iso = Isosurface(VolumeSpline(sphere_grid()), 0.7)
+    iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
     r = agreement(iso, CAM, options={"roots": "paper"}, iterations=5)
     ref_hit = np.isfinite(r["reference_depth"])
     gpu_hit = r["gpu_depth"] < 1.0
@@ -103,10 +104,12 @@ def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     assert wrong.mean() + (ref_hit & ~gpu_hit).sum() / ref_hit.sum() <= 0.05
 
 
-@pytest.mark.skipif("cubic" not in SCHEME_DEGREE, reason="never: cubic is part of SCHEME_DEGREE")
-def test_cubic_sphere_matches_twin():
+@pytest.mark.parametrize("options", [{}, {"roots": "bracketed"}, {"proxy": "cubes"}],
+                         ids=["analytic", "bracketed", "cubes"])
+def test_cubic_sphere_matches_twin(options):
+    assert "cubic" in SCHEME_DEGREE
     iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
-    check(agreement(iso, CAM))
+    check(agreement(iso, CAM, options=options))
 
 
 def test_anisotropic_spacing_and_utm_sized_origin():
@@ -203,6 +206,8 @@ def test_options_are_validated():
         isosurface_program(iso, encoding="texture")
     with pytest.raises(ValueError, match="roots"):
         isosurface_program(iso, roots="cardano")
+    with pytest.raises(ValueError, match="for quadratics the paper"):
+        isosurface_program(iso, roots="paper")
     with pytest.raises(ValueError, match="isovalue must be finite"):
         Isosurface(iso.spline, float("nan"))
 
@@ -243,7 +248,7 @@ def test_frustum_culling_draws_fewer_cubes_and_the_same_image():
     out = {}
     for cull in (False, True):
         pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
-        a = pl.add_isosurface(g, 0.5, culling=cull, lights=1)
+        a = pl.add_isosurface(g, 0.5, culling=cull, lights=1, program_options={"block_size": 4})
         pl.camera_position = [(0.9, 0.7, 0.9), (0.3, 0.2, 0.3), (0, 0, 1)]  # a close-up: most cubes outside
         pl.camera.view_angle = 30
         pl.reset_camera_clipping_range()
@@ -251,8 +256,7 @@ def test_frustum_culling_draws_fewer_cubes_and_the_same_image():
                      len(a.model.relevant.cubes))
         pl.close()
     assert np.array_equal(out[True][0], out[False][0]) and np.array_equal(out[True][1], out[False][1])
-    assert out[False][2] == out[False][3]
-    assert out[True][2] < 0.7 * out[True][3]
+    assert out[True][2] < 0.7 * out[False][2]
     assert (out[True][1] < 1).sum() > 2000
 
 

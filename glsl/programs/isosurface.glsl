@@ -11,8 +11,8 @@
 //    averaging rules (encoding "data", the determining data of paper 003 sec. 5.1 taken to the limit: one
 //    value per cube) or read from a table (encoding "coefficients": every coefficient stored);
 // 3. restriction to the segment by blossoming (Fig. 10), isovalue subtracted, first root in [0, 1]:
-//    quadratic by the stable closed form, cubic by bracketed Newton (default) or paper 003's Newton from
-//    three starts (SV_ROOTS_PAPER_NEWTON);
+//    by the stable closed form of the degree (default), bracketed Newton, or paper 003's Newton from three
+//    starts (selectable; splinevis.volume.root_methods measures them against the robust reference);
 // 4. the smallest t over the tetrahedra wins in the cube; across cubes the depth test picks the first.
 // Normal: gradient of s from the degree n - 1 coefficients at the hit (paper 003, sec. 5.3, last para).
 // The float64 twin is splinevis.volume.raycast.
@@ -35,6 +35,10 @@ uniform float sv_inner_margin;    // and lam_1..3 (faces inside the cube), see s
 uniform int sv_tex_width;         // texels per row of the data / coefficient texture
 uniform vec3 sv_padded_dims;      // (nx + 2, ny + 2, nz + 2)
 uniform vec3 sv_cube_count;       // (nx, ny, nz): hit.uv = (x, y) / (nx, ny)
+#ifdef SV_VOLUME_BLOCKS
+uniform int sv_block_size;        // cubes per block edge (proxies are blocks)
+const int SV_MAX_BLOCK = 16;      // largest supported block edge (loop bound of the cube walk)
+#endif
 
 #ifdef SV_VOLUME_COLOR_FIELD
 // A second field on the same grid (the sampler sv_color_data, same layout as sv_volume_data): the
@@ -57,10 +61,9 @@ float sv_fetch_linear(int n) {
 }
 
 #ifdef SV_VOLUME_TABLE
-// Coefficients of the cube's r-th relevant tetrahedron, row (first row of the cube) + r of the table.
+// Coefficients of tetrahedron t from row `r` of the table (the cube's first row + the tetrahedron's rank).
 void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
-    int row = 4096 * int(sv_cube_extraVSOut.y + 0.5) + int(sv_cube_extraVSOut.z + 0.5);
-    int base = (row + r) * SV_VOL_NCOEF;
+    int base = r * SV_VOL_NCOEF;
     for (int q = 0; q < SV_VOL_NCOEF; ++q) b[q] = sv_fetch_linear(base + q);
 }
 #else
@@ -97,11 +100,18 @@ void sv_load_stencil(ivec3 c, out float f[27]) {
 #endif
 }
 
+// First root in [0, 1] of the restricted polynomial minus the isovalue: the stable closed form of the
+// degree (default), paper 003's Newton from three starts (SV_ROOTS_PAPER_NEWTON3), or bracketed Newton on
+// convex pieces (SV_ROOTS_BRACKETED); the float64/float32 twins are in splinevis.bb.roots.
 float sv_first_root_deg(float c[5]) {
-#if !defined(SV_VOLUME_CUBIC) && !defined(SV_ROOTS_PAPER_NEWTON) && !defined(SV_ROOTS_BRACKETED)
-    return sv_first_root_quadratic(c);
+#if defined(SV_ROOTS_PAPER_NEWTON3)
+    return sv_first_root_newton3(c, sv_newton_iterations);
+#elif defined(SV_ROOTS_BRACKETED)
+    return sv_first_root_bracketed(c, SV_VOL_DEGREE, sv_newton_iterations);
+#elif defined(SV_VOLUME_CUBIC)
+    return sv_first_root_cubic(c);
 #else
-    return sv_first_root(c, SV_VOL_DEGREE, sv_newton_iterations);
+    return sv_first_root_quadratic(c);
 #endif
 }
 
@@ -158,19 +168,13 @@ vec2 sv_tet_curvature(float b[SV_VOL_NCOEF], int t, vec4 l, vec3 g) {
 }
 #endif
 
-bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
-    hit.curvature = vec2(0.0);
-    hit.depth = 0.0;
-    ivec3 c = ivec3(sv_cubeVSOut.xyz + 0.5);
-    int mask = int(sv_cubeVSOut.w + 0.5) + 4096 * int(sv_cube_extraVSOut.x + 0.5);
-    // The ray in cube-local coordinates: the interpolated local position of this fragment (exact at the
-    // proxy's corners) and the direction in index units; t is the model-space parameter of ro + t rd.
-    vec3 P0 = sv_localVSOut;
-    vec3 D = sv_inv_spacing * rd;
-    float f[27];
-    sv_load_stencil(c, f);
+// First hit (smallest t >= tmin) inside cube c along the cube-local ray P0 + t D over the cube's relevant
+// tetrahedra (mask); returns SV_NO_HIT if none, else t with the tetrahedron and its rank in the table.
+float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin, float f[27],
+                        out int tet_best, out int rank_best) {
     float t_best = SV_NO_HIT;
-    int tet_best = -1;
+    tet_best = -1;
+    rank_best = 0;
     int r = 0;   // rank of t among the cube's relevant tetrahedra (row in the coefficient table)
     for (int t = 0; t < 24; ++t) {
         if (((mask >> t) & 1) == 0) continue;
@@ -194,7 +198,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         }
         if (empty || !(ta <= tb) || ta >= t_best) continue;
         float b[SV_VOL_NCOEF];
-        sv_load_tet(t, rank, f, b);
+        sv_load_tet(t, row + rank, f, b);
         float cc[5];
         sv_restrict(b, lo + ta * ld, lo + tb * ld, cc);
         for (int k = 0; k <= SV_VOL_DEGREE; ++k) cc[k] -= sv_iso_shifted;
@@ -204,13 +208,106 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         if (th < t_best) {
             t_best = th;
             tet_best = t;
-            hit.uv = vec2(float(rank), 0.0);  // remembered for the normal below
+            rank_best = rank;
         }
     }
+    return t_best;
+}
+
+#ifdef SV_VOLUME_BLOCKS
+// Per-cube masks and table rows of the whole grid (sampler sv_volume_mask, linear layout, x fastest):
+// .r = mask (24 bits, exact in float32), .g/.b = first table row as 12-bit halves.
+vec4 sv_cube_info(ivec3 c) {
+    ivec3 n = ivec3(sv_cube_count + 0.5);
+    int k = (c.z * n.y + c.y) * n.x + c.x;
+    return texelFetch(sv_volume_mask, ivec2(k % sv_tex_width, k / sv_tex_width), 0);
+}
+#endif
+
+bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    hit.curvature = vec2(0.0);
+    hit.depth = 0.0;
+    vec3 D = sv_inv_spacing * rd;   // index units per unit of t (t is the model-space parameter of ro + t rd)
+    float f[27];
+    float t_best = SV_NO_HIT;
+    int tet_best = -1;
+    int rank_best = 0;
+    int row = 0;
+    ivec3 c;
+    vec3 P0;
+#ifdef SV_VOLUME_BLOCKS
+    // Proxy = a block of cubes: walk its cubes front to back (3-D DDA) and stop at the first hit. The
+    // fragment's block-local position (exact at the block's corners) locates the ray; cube a of the block
+    // spans [a, a + 1] in these coordinates.
+    ivec3 b0 = ivec3(sv_cubeVSOut.xyz + 0.5);                 // first cube of the block
+    vec3 ext = min(vec3(sv_block_size), sv_cube_count - vec3(b0));
+    vec3 Pb = sv_localVSOut;
+    float t0 = tmin;
+    float t1 = 3.0e38;
+    for (int k = 0; k < 3; ++k) {
+        if (abs(D[k]) < 1e-30) continue;
+        float ta = (0.0 - Pb[k]) / D[k];
+        float tb = (ext[k] - Pb[k]) / D[k];
+        t0 = max(t0, min(ta, tb));
+        t1 = min(t1, max(ta, tb));
+    }
+    if (!(t0 <= t1)) return false;
+    ivec3 iext = ivec3(ext + 0.5);
+    // start in the cube holding the entry point, nudged inside along the ray
+    ivec3 a = clamp(ivec3(floor(Pb + (t0 + 1e-4 * (t1 - t0)) * D)), ivec3(0), iext - ivec3(1));
+    ivec3 stepdir = ivec3(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1, D.z > 0.0 ? 1 : -1);
+    for (int s = 0; s < 3 * SV_MAX_BLOCK; ++s) {
+        vec3 lo = vec3(a);
+        vec3 texit;
+        for (int k = 0; k < 3; ++k) {
+            texit[k] = abs(D[k]) < 1e-30 ? 3.0e38 : ((D[k] > 0.0 ? lo[k] + 1.0 : lo[k]) - Pb[k]) / D[k];
+        }
+        float tb = min(min(texit.x, texit.y), texit.z);
+        ivec3 cc = b0 + a;
+        vec4 info = sv_cube_info(cc);
+        // info holds exact integers; no "+ 0.5" rounding: above 2^23 float32 cannot hold x + 0.5 and
+        // rounds it to the even neighbour, which flips the low bits of a mask with bit 23 set
+        int mask = int(info.r);
+        if (mask != 0) {
+            int crow = 4096 * int(info.g) + int(info.b);
+            vec3 Pc = Pb - vec3(a);
+            sv_load_stencil(cc, f);
+            int tb_tet;
+            int tb_rank;
+            // tetrahedra are clipped by their own (margin-widened) barycentric extent, not by the block's
+            // segment, so a root on a block face is found by the cubes on both sides (no crack)
+            float th = sv_cube_first_hit(cc, mask, crow, Pc, D, tmin, f, tb_tet, tb_rank);
+            if (th < SV_NO_HIT) {
+                t_best = th;
+                tet_best = tb_tet;
+                rank_best = tb_rank;
+                row = crow;
+                c = cc;
+                P0 = Pc;
+                break;
+            }
+        }
+        if (tb >= t1) break;
+        if (texit.x <= texit.y && texit.x <= texit.z) a.x += stepdir.x;
+        else if (texit.y <= texit.z) a.y += stepdir.y;
+        else a.z += stepdir.z;
+        if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, iext))) break;
+    }
     if (tet_best < 0) return false;
+#else
+    c = ivec3(sv_cubeVSOut.xyz + 0.5);
+    int mask = int(sv_cubeVSOut.w + 0.5) + 4096 * int(sv_cube_extraVSOut.x + 0.5);
+    row = 4096 * int(sv_cube_extraVSOut.y + 0.5) + int(sv_cube_extraVSOut.z + 0.5);
+    // The ray in cube-local coordinates: the interpolated local position of this fragment (exact at the
+    // proxy's corners).
+    P0 = sv_localVSOut;
+    sv_load_stencil(c, f);
+    t_best = sv_cube_first_hit(c, mask, row, P0, D, tmin, f, tet_best, rank_best);
+    if (tet_best < 0) return false;
+#endif
 
     float b[SV_VOL_NCOEF];
-    sv_load_tet(tet_best, int(hit.uv.x + 0.5), f, b);
+    sv_load_tet(tet_best, row + rank_best, f, b);
     vec3 P = P0 + t_best * D;
     vec4 l;
     for (int i = 0; i < 4; ++i) {

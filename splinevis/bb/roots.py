@@ -643,7 +643,7 @@ def first_root_quadratic(c, *, dtype=np.float64):
 __all__ += ["first_root_cubic", "newton_three_starts", "CUBIC_POLISH"]
 
 #: Newton steps polishing the closed-form candidates (``SV_CUBIC_POLISH`` in ``glsl/lib/roots.glsl``).
-CUBIC_POLISH = 2
+CUBIC_POLISH = 1
 _SQRT3 = 1.7320508075688772
 
 
@@ -679,7 +679,9 @@ def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
     ``sqrt`` of the depressed discriminants is taken as ``|A| sqrt(|disc|)`` resp. ``|D| sqrt(|disc|)``
     (exact identities). The four candidates (non-finite dropped, the rest clamped to [0, 1]) get ``polish``
     Newton steps on the BB form; every iterate is tested with ``|f(x)| <= K_3 EPS32 sum |c_k| B_k(x)``
-    (:func:`root_tolerance_k`), each lane keeps its last passing iterate, the smallest wins.
+    (:func:`root_tolerance_k`) widened by the argument rounding ``EPS32 |x f'(x)|`` (needed where
+    ``|f'| ulp / 2`` exceeds the evaluation error: no float32 number passes the plain test there); each
+    lane keeps its passing iterate of smallest ``|f|``, the smallest accepted ``t`` wins.
 
     Parameters
     ----------
@@ -688,7 +690,7 @@ def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
     dtype : {numpy.float64, numpy.float32}
         float32 emulates the GPU (without FMA).
     polish : int
-        Newton steps after the closed form (0..4); the GLSL uses ``SV_CUBIC_POLISH`` (default 2).
+        Newton steps after the closed form (0..4); the GLSL uses ``SV_CUBIC_POLISH`` (default 1).
 
     Returns
     -------
@@ -754,11 +756,14 @@ def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
         ca4 = np.abs(c4)
         kt = dt(root_tolerance_k(3)) * dt(EPS32)
         acc = np.full(x.shape, 2.0, dtype=dt)
+        accf = np.full(x.shape, np.finfo(np.float32).max, dtype=dt)
         for it in range(polish + 1):
             f, fp = _eval_deriv(c4, x, dt)
             S, _ = _eval_deriv(ca4, x, dt)
             tol = kt * S + dt(EPS32) * np.abs(x * fp)                # ... * S + SV_ROOT_EPS32 * abs(x * fp)
-            acc = np.where(valid & (np.abs(f) <= tol), x, acc)  # a lane keeps its last passing iterate
+            take = valid & (np.abs(f) <= tol) & (np.abs(f) < accf)   # a lane keeps its passing iterate of
+            acc = np.where(take, x, acc)                               # smallest |f|
+            accf = np.where(take, np.abs(f), accf)
             if it < polish:
                 xn = x - f / np.where(fp != 0.0, fp, dt(1.0))
                 ok = valid & (fp != 0.0) & (np.abs(xn) < 1e30)

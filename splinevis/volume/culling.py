@@ -36,7 +36,7 @@ class FrustumCuller:
     Attributes
     ----------
     visible_cubes : int
-        Cubes drawn in the last frame; ``tests`` counts nodes tested.
+        Proxy boxes (cubes or blocks) drawn in the last frame; ``tests`` counts nodes tested.
     """
 
     def __init__(self, actor, level: int | None = None):
@@ -52,10 +52,17 @@ class FrustumCuller:
         self.refresh()
 
     def refresh(self) -> None:
-        """Re-read the relevant cubes (after :func:`~splinevis.volume.program.set_isovalue`)."""
-        rel = self.actor.model.relevant
-        self.cubes = rel.cubes
-        self.block_of_cube = rel.cubes >> self.level  # (n, 3)
+        """Re-read the proxy boxes (after :func:`~splinevis.volume.program.set_isovalue`)."""
+        from .program import BLOCK_SIZE, proxy_units
+
+        spec = self.actor.spec
+        blocks = bool(spec.defines.get("SV_VOLUME_BLOCKS"))
+        B = int(spec.uniforms.get("sv_block_size", BLOCK_SIZE)) if blocks else 1
+        # a culling node must enclose every proxy box assigned to it: theta >= log2(block size)
+        self.level = max(self.level, int(np.ceil(np.log2(B))))
+        first, _ = proxy_units(self.actor.model.spline, self.actor.model.relevant, "blocks" if blocks else "cubes", B)
+        self.cubes = first
+        self.block_of_cube = first >> self.level  # (n, 3)
         self.blocks, self.cube_block = np.unique(self.block_of_cube, axis=0, return_inverse=True)
         self.cube_block = self.cube_block.ravel()
         self._key = None

@@ -30,6 +30,8 @@ from .model import Relevant, VolumeSpline
 __all__ = ["Isosurface", "isosurface_program", "set_isovalue", "data_texture", "coefficient_table", "memory_report",
            "TEXTURE_WIDTH", "CUBE_MARGIN", "INNER_MARGIN"]
 
+#: Cubes per block edge of the default block proxies.
+BLOCK_SIZE = 8
 #: Texels per row of the linear data/coefficient textures (GL_MAX_TEXTURE_SIZE of llvmpipe is 16384).
 TEXTURE_WIDTH = 8192
 #: Clip margin (barycentric units) across the cube's faces (lam_0 >= -margin; lam_0 vanishes on the face of
@@ -134,7 +136,8 @@ def memory_report(spline: VolumeSpline, relevant: Relevant) -> dict:
 
 
 def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encoding: str = "data",
-                       roots: str | None = None, color_field=None) -> ProgramSpec:
+                       roots: str | None = None, color_field=None, proxy: str = "blocks",
+                       block_size: int = BLOCK_SIZE) -> ProgramSpec:
     """Describe the ray-cast program of an isosurface.
 
     Parameters
@@ -144,10 +147,16 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         Iterations of the Newton-type root finders (cubic, or ``roots != "analytic"``).
     encoding : {"data", "coefficients"}
         Where the shader gets BB coefficients from (module docstring).
-    roots : {"analytic", "bracketed", "paper"}, optional
-        Quadratic default ``"analytic"`` (stable closed form); cubic default ``"bracketed"`` (bracketed Newton
-        on convex pieces); ``"paper"``: Newton from the secure starts 0, inflection point(s), 1 with a fixed
-        iteration count (paper 003 sec. 5.3; the shared implementation adds a fourth start at 2/3).
+    roots : {"analytic", "bracketed", "paper"}, default "analytic"
+        ``"analytic"``: the stable closed form (quadratic formula; for the cubic the trigonometric/Cardano
+        form on the BB coefficients, ``sv_first_root_cubic``); ``"bracketed"``: bracketed Newton on convex
+        pieces; ``"paper"``: paper 003's Newton from the three starts 0, inflection point (1/2 if none), 1 with
+        ``newton_iterations`` steps (sec. 5.3; cubic scheme only, the paper solves quadratics in closed form).
+    proxy : {"blocks", "cubes"}
+        Bounding geometry: ``"blocks"`` (default) draws one box per block of ``block_size``^3 cubes holding
+        relevant cubes; each fragment walks the block's cubes front to back and stops at the first hit.
+        ``"cubes"`` draws one box per relevant cube (closest to paper 003's per-tetrahedron proxies: every
+        relevant cube a ray crosses costs a fragment, measured in the study).
     color_field : array-like (nz, ny, nx) or VolumeGrid, optional
         A second field on the same grid; the surface is coloured by its spline (same scheme) at the hit
         through the Style's colormap (``scalar_range`` defaults to the field's range).
@@ -157,17 +166,21 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     spline = model.spline
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
     check_choice(encoding, "encoding", {"data", "coefficients"})
+    check_choice(proxy, "proxy", {"blocks", "cubes"})
+    block_size = check_degree(block_size, "block_size", low=1, high=16)
     cubic = spline.degree == 3
     if roots is None:
-        roots = "bracketed" if cubic else "analytic"
+        roots = "analytic"
     check_choice(roots, "roots", {"analytic", "bracketed", "paper"})
-    if roots == "analytic" and cubic:
-        raise ValueError("roots='analytic' is the closed form for quadratics; for the cubic scheme use "
-                         "'bracketed' (default) or 'paper'.")
+    if roots == "paper" and not cubic:
+        raise ValueError("roots='paper' is paper 003's Newton iteration for cubics; for quadratics the paper (and "
+                         "roots='analytic') uses the closed form. Use roots='analytic' or 'bracketed'.")
     rel = model.relevant
-    points, tris, attributes, varyings = _proxies(spline, rel, encoding)
+    points, tris, attributes, varyings = _proxies(spline, rel, encoding, proxy, block_size)
     ref = value_reference(spline)
     textures = {}
+    if proxy == "blocks":
+        textures["sv_volume_mask"] = mask_texture(spline, rel)
     if encoding == "data":
         textures["sv_volume_data"] = data_texture(spline)
     else:
@@ -192,8 +205,8 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         triangles=tris,
         offset=tuple(spline.origin),
         defines={"SV_VOLUME_CUBIC": cubic, "SV_VOLUME_TABLE": encoding == "coefficients",
-                 "SV_VOLUME_COLOR_FIELD": color_field is not None,
-                 "SV_ROOTS_PAPER_NEWTON": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
+                 "SV_VOLUME_COLOR_FIELD": color_field is not None, "SV_VOLUME_BLOCKS": proxy == "blocks",
+                 "SV_ROOTS_PAPER_NEWTON3": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
         uniforms={
             "sv_inv_spacing": tuple(1.0 / spline.spacing),
             "sv_iso_shifted": model.isovalue - ref,
@@ -204,6 +217,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
             "sv_tex_width": TEXTURE_WIDTH,
             "sv_padded_dims": (float(nx + 2), float(ny + 2), float(nz + 2)),
             "sv_cube_count": (float(nx), float(ny), float(nz)),
+            "sv_block_size": block_size,
             "sv_scalar_range": scalar_range,
         },
         textures=textures,
@@ -212,19 +226,56 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     )
 
 
-def _proxies(spline: VolumeSpline, rel: Relevant, encoding: str):
-    """Bounding geometry of the relevant cubes: points (model frame), triangles, flat attributes, varyings."""
+def _table_rows(rel: Relevant) -> np.ndarray:
+    counts = np.bitwise_count(rel.masks).astype(np.int64)
+    return np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
+
+
+def mask_texture(spline: VolumeSpline, rel: Relevant) -> np.ndarray:
+    """(rows, TEXTURE_WIDTH, 4) float32, one texel per cube of the grid (x fastest): the relevant-tetrahedron
+    mask (exact: < 2^24) and the cube's first coefficient-table row as two 12-bit halves; 0 = not relevant."""
+    nz, ny, nx = spline.shape
+    info = np.zeros((nz * ny * nx, 4), dtype=np.float32)
+    if len(rel.cubes):
+        k = (rel.cubes[:, 2] * ny + rel.cubes[:, 1]) * nx + rel.cubes[:, 0]
+        rows = _table_rows(rel)
+        info[k, 0] = rel.masks
+        info[k, 1] = rows >> 12
+        info[k, 2] = rows & 4095
+    return _linear_texture(info)
+
+
+def proxy_units(spline: VolumeSpline, rel: Relevant, proxy: str, block_size: int):
+    """The proxy boxes as (first cube (n, 3) int, cubes per axis (n, 3) int), in drawing order."""
+    if proxy == "blocks":
+        B = block_size
+        first = np.unique(rel.cubes // B, axis=0) * B if len(rel.cubes) else np.zeros((0, 3), np.int64)
+        return first, np.minimum(B, np.array(spline.shape[::-1]) - first)
+    return rel.cubes, np.ones_like(rel.cubes)
+
+
+def _proxies(spline: VolumeSpline, rel: Relevant, encoding: str, proxy: str = "cubes", block_size: int = 8):
+    """Bounding geometry: points (model frame), triangles, flat attributes, varyings."""
+    if proxy == "blocks":
+        first, ext = proxy_units(spline, rel, proxy, block_size)
+        n = len(first)
+        local = _CORNERS[None] * ext[:, None, :]  # block-local corner coordinates, cube units
+        corners = (first[:, None, :] - 0.5 + local) * spline.spacing
+        tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
+        cube_attr = np.repeat(np.column_stack([first, np.zeros(n)]).astype(np.float64), 8, axis=0)
+        attributes = {"sv_cube": cube_attr}
+        return corners.reshape(-1, 3), tris, attributes, {"sv_local": local.reshape(-1, 3)}
     n = len(rel.cubes)
     corners = (rel.cubes[:, None, :] - 0.5 + _CORNERS[None]) * spline.spacing  # model frame: origin at data point 0
     tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
-    # Integers above 2^16 lose low bits on their way through VTK's vertex attributes here (measured: the
-    # low 7 bits of a 24-bit mask vanished), so masks and rows travel as 12-bit halves.
+    # Masks and rows travel as 12-bit halves so that the shader's int(x + 0.5) is exact: for x >= 2^23 the
+    # float32 sum x + 0.5 rounds to the even neighbour, which flipped the low bits of masks with bit 23 set
+    # (the cause of the first holes in the sphere; it was first mistaken for VTK attribute precision).
     cube_attr = np.repeat(np.column_stack([rel.cubes, rel.masks & 4095]).astype(np.float64), 8, axis=0)
     extra = np.zeros((n, 3))
     extra[:, 0] = rel.masks >> 12
     if encoding == "coefficients":
-        counts = np.bitwise_count(rel.masks).astype(np.int64)
-        rows = np.concatenate([[0], np.cumsum(counts)[:-1]]) if n else np.zeros(0, np.int64)
+        rows = _table_rows(rel)
         extra[:, 1] = rows >> 12
         extra[:, 2] = rows & 4095
     attributes = {"sv_cube": cube_attr, "sv_cube_extra": np.repeat(extra, 8, axis=0)}
@@ -247,8 +298,12 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
         raise ValueError(f"isovalue must be finite, got {isovalue!r}.")
     spline, rel = model.spline, model.relevant
     encoding = "coefficients" if actor.spec.defines.get("SV_VOLUME_TABLE") else "data"
-    points, tris, attributes, varyings = _proxies(spline, rel, encoding)
+    blocks = bool(actor.spec.defines.get("SV_VOLUME_BLOCKS"))
+    B = int(actor.spec.uniforms.get("sv_block_size", BLOCK_SIZE))
+    points, tris, attributes, varyings = _proxies(spline, rel, encoding, "blocks" if blocks else "cubes", B)
     actor.set_geometry(points, tris, {**attributes, **varyings})
+    if blocks:
+        actor.set_texture("sv_volume_mask", mask_texture(spline, rel))
     if encoding == "coefficients":
         actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
     actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)

@@ -7,7 +7,8 @@ blossoming (:func:`splinevis.bb.simplex.restrict_to_segment`) and the first root
 * ``method="reference"`` (default): :func:`splinevis.bb.roots.first_root_reference`, the robust float64
   method (every root isolated), the truth the GPU is measured against;
 * ``"analytic"``, ``"bracketed"``, ``"paper"``: the GPU's methods in float64 (the twins of
-  ``sv_first_root_quadratic``, ``sv_first_root_bracketed``, ``sv_first_root_newton4``).
+  ``sv_first_root_quadratic`` / ``sv_first_root_cubic``, ``sv_first_root_bracketed``,
+  ``sv_first_root_newton3``).
 
 The smallest hit over the tetrahedra of the first cube with a hit wins (cubes are visited in ray order,
 so no later cube can hold an earlier hit).
@@ -29,10 +30,10 @@ def _first_root(c, method, iterations):
     if method == "reference":
         return R.first_root_reference(c)
     if method == "analytic":
-        return R.first_root_quadratic(c)
+        return R.first_root_quadratic(c) if c.shape[-1] == 3 else R.first_root_cubic(c)
     if method == "bracketed":
         return R.first_root_bracketed(c, iterations)
-    return R.newton_secure(c, iterations)
+    return R.newton_three_starts(c, iterations)
 
 
 def raycast_isosurface(model: Isosurface, origins, directions, *, tmin=0.0, method: str = "reference",
