@@ -215,11 +215,11 @@ float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin,
 }
 
 #ifdef SV_VOLUME_BLOCKS
-// Per-cube masks and table rows of the whole grid (sampler sv_volume_mask, linear layout, x fastest):
-// .r = mask (24 bits, exact in float32), .g/.b = first table row as 12-bit halves.
-vec4 sv_cube_info(ivec3 c) {
-    ivec3 n = ivec3(sv_cube_count + 0.5);
-    int k = (c.z * n.y + c.y) * n.x + c.x;
+// Per-cube masks and table rows of the drawn blocks (sampler sv_volume_mask, one texel per cube, block after
+// block, x fastest inside a block): .r = mask (24 bits, exact in float32), .g/.b = first table row as
+// 12-bit halves. `a` is the cube within block `block`.
+vec4 sv_cube_info(int block, ivec3 a) {
+    int k = (block * sv_block_size + a.z) * sv_block_size * sv_block_size + a.y * sv_block_size + a.x;
     return texelFetch(sv_volume_mask, ivec2(k % sv_tex_width, k / sv_tex_width), 0);
 }
 #endif
@@ -240,6 +240,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     // fragment's block-local position (exact at the block's corners) locates the ray; cube a of the block
     // spans [a, a + 1] in these coordinates.
     ivec3 b0 = ivec3(sv_cubeVSOut.xyz + 0.5);                 // first cube of the block
+    int block = int(sv_cubeVSOut.w);                          // exact integer (no rounding: see below)
     vec3 ext = min(vec3(sv_block_size), sv_cube_count - vec3(b0));
     vec3 Pb = sv_localVSOut;
     float t0 = tmin;
@@ -264,7 +265,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         }
         float tb = min(min(texit.x, texit.y), texit.z);
         ivec3 cc = b0 + a;
-        vec4 info = sv_cube_info(cc);
+        vec4 info = sv_cube_info(block, a);
         // info holds exact integers; no "+ 0.5" rounding: above 2^23 float32 cannot hold x + 0.5 and
         // rounds it to the even neighbour, which flips the low bits of a mask with bit 23 set
         int mask = int(info.r);

@@ -262,20 +262,22 @@ def _timed(pl, repeats):
     return {"frame_min_ms": r["min_ms"], "frame_median_ms": r["median_ms"], "repeats": r["repeats"]}
 
 
-def measure_spline(ref: Reference, spline, *, roots=None, iterations=2, encoding="data", repeats=3) -> dict:
+def measure_spline(ref: Reference, spline, *, roots=None, iterations=2, encoding="data", proxy="blocks",
+                   repeats=3) -> dict:
     """One spline configuration: GPU frame time and coverage; positions and normals from the float64 twin."""
     from ..plotting import Plotter
     from ..volume.program import Isosurface
     from ..volume.raycast import raycast_isosurface
 
     cubic = spline.degree == 3
-    roots = roots or ("bracketed" if cubic else "analytic")
+    roots = roots or "analytic"
     iso = Isosurface(spline, ref.field.isovalue)
     t0 = time.perf_counter()
     rel = iso.relevant
     pre = time.perf_counter() - t0
     pl = Plotter(off_screen=True, window_size=ref.window)
-    pl.add_spline(iso, lights=1, newton_iterations=iterations, program_options={"encoding": encoding, "roots": roots})
+    pl.add_spline(iso, lights=1, newton_iterations=iterations,
+                  program_options={"encoding": encoding, "roots": roots, "proxy": proxy})
     _set_camera(pl)
     timing = _timed(pl, repeats)
     gpu_cov = pl.depth_buffer() < 1.0
@@ -286,8 +288,8 @@ def measure_spline(ref: Reference, spline, *, roots=None, iterations=2, encoding
     points = ref.o + np.where(twin_cov, t, np.nan)[..., None] * ref.d
     normals = g.reshape(points.shape)
     row = {"kind": f"spline {spline.scheme}", "method": f"{spline.scheme} spline",
-           "config": f"{encoding}, {roots}" + ("" if roots == "analytic" else f", {iterations} it."),
-           "scheme": spline.scheme, "encoding": encoding, "roots": roots,
+           "config": f"{proxy}, {encoding}, {roots}" + ("" if roots == "analytic" else f", {iterations} it."),
+           "scheme": spline.scheme, "encoding": encoding, "roots": roots, "proxy": proxy,
            "iterations": None if roots == "analytic" else iterations, "elements": int(rel.num_tets),
            "relevant_cubes": int(len(rel.cubes)), "relevant_seconds": pre, **timing,
            "gpu_twin_coverage_disagree": int((gpu_cov != twin_cov).sum())}
@@ -397,13 +399,17 @@ def measure_vtk(ref: Reference, *, sample_distance=None, repeats=3) -> dict:
 
 
 def spline_configs(quick, cubic):
-    q = [("quadratic", "data", "analytic", 1), ("quadratic", "coefficients", "analytic", 1), ("quadratic", "data", "paper", 2)]
-    c = [("cubic", "data", "bracketed", 2), ("cubic", "data", "paper", 2)]
+    """(scheme, encoding, roots, iterations, proxy) of the measured spline programs. Paper 003's Newton
+    (``"paper"``) exists for the cubic only: the paper solves quadratics in closed form."""
+    q = [("quadratic", "data", "analytic", 1, "blocks"), ("quadratic", "coefficients", "analytic", 1, "blocks"),
+         ("quadratic", "data", "analytic", 1, "cubes")]
+    c = [("cubic", "data", "analytic", 1, "blocks"), ("cubic", "data", "paper", 5, "blocks"),
+         ("cubic", "data", "bracketed", 2, "blocks")]
     if not quick:
-        q += [("quadratic", "data", "paper", 1), ("quadratic", "data", "paper", 4), ("quadratic", "data", "bracketed", 2),
-              ("quadratic", "data", "bracketed", 4)]
-        c += [("cubic", "data", "bracketed", 1), ("cubic", "data", "bracketed", 4), ("cubic", "data", "paper", 4),
-              ("cubic", "coefficients", "bracketed", 2)]
+        q += [("quadratic", "data", "bracketed", 2, "blocks"), ("quadratic", "data", "bracketed", 4, "blocks")]
+        c += [("cubic", "data", "paper", 2, "blocks"), ("cubic", "data", "paper", 8, "blocks"),
+              ("cubic", "data", "bracketed", 4, "blocks"), ("cubic", "coefficients", "analytic", 1, "blocks"),
+              ("cubic", "data", "analytic", 1, "cubes")]
     return q + (c if cubic else [])
 
 
@@ -431,10 +437,11 @@ def accuracy_vs_time(*, quick=False, cubic=True, repeats=None, n=None, progress=
         elif job[0] == "vtk":
             rows.append(measure_vtk(ref, sample_distance=ref.h / job[1], repeats=repeats))
         else:
-            _, scheme, enc, roots, k = job
+            _, scheme, enc, roots, k, proxy = job
             if scheme not in splines:
                 splines[scheme] = VolumeSpline(grid, scheme)
-            rows.append(measure_spline(ref, splines[scheme], roots=roots, iterations=k, encoding=enc, repeats=repeats))
+            rows.append(measure_spline(ref, splines[scheme], roots=roots, iterations=k, encoding=enc, proxy=proxy,
+                                       repeats=repeats))
     setup = {"field": f"torus distance R={field.R}, r={field.r}, isovalue {field.isovalue}", "grid": f"{n}^3",
              "h": ref.h, "window": list(window), "camera": CAMERA, "clipping_range": list(CLIP), "repeats": repeats,
              "pixels_exact": int(ref.covered.sum()), "pixel_footprint_world": ref.pixel_size,
@@ -447,7 +454,8 @@ def _short(r):
         return f"{r['upsample']}x"
     if r["method"] == "VTK volume":
         return r["config"].replace("sample distance ", "")
-    return ("D" if r["encoding"] == "data" else "C") + "/" + r["roots"][:2] + ("" if r["iterations"] is None else str(r["iterations"]))
+    return (("" if r.get("proxy", "blocks") == "blocks" else "cubes ") + ("D" if r["encoding"] == "data" else "C") + "/"
+            + r["roots"][:2] + ("" if r["iterations"] is None else str(r["iterations"])))
 
 
 def pareto_figure(rows, setup, path):

@@ -283,20 +283,33 @@ class VolumeSpline:
         cand = self.octree.candidates(iso)
         cubes, masks = [], []
         bits = (np.int64(1) << np.arange(NUM_TETS, dtype=np.int64))
-        # the 24 m coefficients of a cube are few distinct combinations of its data (65 for the quadratic,
-        # shared between neighbouring tetrahedra): compute those once, then min/max per tetrahedron with
-        # m - 1 elementwise operations on (n, 24) gathers
+        # The 24 m coefficients of a cube are few distinct combinations of its data (65 for the quadratic,
+        # shared between neighbouring tetrahedra): those are computed once per cube, in float32, and the
+        # test is widened by their rounding error, so the result is a superset of the exact float64 answer
+        # (a spare tetrahedron is tested by the shader and simply has no root). Bound: a coefficient is
+        # sum_s w_s f_s with sum |w_s| <= 1 + 2 N (N the negative weight mass) -- at most 27 roundings of terms
+        # bounded by (1 + 2 N) F, F = max |data - ref| -- so |error| <= 28 u32 (1 + 2 N) F; doubled for safety
+        # of the float32 comparison itself.
         Wd, tmap = self._distinct_weights()
+        Wd32 = Wd.astype(np.float32)
+        ref = 0.5 * (self.value_range[0] + self.value_range[1])
+        F = max(abs(self.value_range[0] - ref), abs(self.value_range[1] - ref), abs(iso - ref))
+        delta = np.float32(2 * 28 * 2.0**-24 * (1 + 2 * _negative_mass(self.weights)) * max(F, 1e-300))
+        iso32 = np.float32(iso - ref)
+        a32, b32 = iso32 - delta, iso32 + delta
         for s in range(0, len(cand), chunk):
             c = cand[s:s + chunk]
-            coef = self.stencil_data(c) @ Wd  # (n, distinct)
+            coef = (self.stencil_data(c) - ref).astype(np.float32) @ Wd32  # (n, distinct)
+            # cube level first: a cube whose distinct coefficients all miss the isovalue has no relevant tet
+            straddle = (coef.min(axis=1) <= b32) & (coef.max(axis=1) >= a32)
+            c, coef = c[straddle], coef[straddle]
             lo = coef[:, tmap[:, 0]]
             hi = lo.copy()
             for q in range(1, self.ncoef):
                 col = coef[:, tmap[:, q]]
                 np.minimum(lo, col, out=lo)
                 np.maximum(hi, col, out=hi)
-            rel = (lo <= iso) & (iso <= hi)
+            rel = (lo <= b32) & (a32 <= hi)
             m = rel @ bits
             keep = m != 0
             cubes.append(c[keep])

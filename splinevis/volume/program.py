@@ -85,18 +85,20 @@ def value_reference(spline: VolumeSpline) -> float:
     return 0.5 * (lo + hi)
 
 
-def _linear_texture(values: np.ndarray) -> np.ndarray:
-    flat = np.asarray(values, dtype=np.float32).ravel()
+def _linear_texture(values: np.ndarray, shift: float = 0.0) -> np.ndarray:
+    """Values (minus ``shift``) packed 4 per RGBA32F texel, row after row of TEXTURE_WIDTH texels."""
+    flat = np.asarray(values).reshape(-1)
     ntex = -(-len(flat) // 4)
     rows = max(1, -(-ntex // TEXTURE_WIDTH))
-    buf = np.zeros(rows * TEXTURE_WIDTH * 4, dtype=np.float32)
-    buf[: len(flat)] = flat
+    buf = np.empty(rows * TEXTURE_WIDTH * 4, dtype=np.float32)
+    np.subtract(flat, shift, out=buf[: len(flat)], casting="same_kind")  # no float64 temporary
+    buf[len(flat):] = 0
     return buf.reshape(rows, TEXTURE_WIDTH, 4)
 
 
 def data_texture(spline: VolumeSpline) -> np.ndarray:
     """(rows, TEXTURE_WIDTH, 4) float32: the padded volume minus :func:`value_reference`, x fastest."""
-    return _linear_texture(spline.padded - value_reference(spline))
+    return _linear_texture(spline.padded, value_reference(spline))
 
 
 def coefficient_table(spline: VolumeSpline, relevant: Relevant):
@@ -180,7 +182,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     ref = value_reference(spline)
     textures = {}
     if proxy == "blocks":
-        textures["sv_volume_mask"] = mask_texture(spline, rel)
+        textures["sv_volume_mask"] = mask_texture(spline, rel, block_size)
     if encoding == "data":
         textures["sv_volume_data"] = data_texture(spline)
     else:
@@ -231,13 +233,22 @@ def _table_rows(rel: Relevant) -> np.ndarray:
     return np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
 
 
-def mask_texture(spline: VolumeSpline, rel: Relevant) -> np.ndarray:
-    """(rows, TEXTURE_WIDTH, 4) float32, one texel per cube of the grid (x fastest): the relevant-tetrahedron
-    mask (exact: < 2^24) and the cube's first coefficient-table row as two 12-bit halves; 0 = not relevant."""
-    nz, ny, nx = spline.shape
-    info = np.zeros((nz * ny * nx, 4), dtype=np.float32)
+def mask_texture(spline: VolumeSpline, rel: Relevant, block_size: int = BLOCK_SIZE) -> np.ndarray:
+    """(rows, TEXTURE_WIDTH, 4) float32: for every block drawn (in :func:`proxy_units` order) one texel per
+    cube of the block, ``block_id * B^3 + (a_z B + a_y) B + a_x``: the relevant-tetrahedron mask (exact:
+    < 2^24), the cube's first coefficient-table row as two 12-bit halves, 0 = not relevant. Only blocks
+    holding relevant cubes are stored."""
+    B = block_size
+    first, _ = proxy_units(spline, rel, "blocks", B)
+    info = np.zeros((len(first) * B ** 3, 4), dtype=np.float32)
     if len(rel.cubes):
-        k = (rel.cubes[:, 2] * ny + rel.cubes[:, 1]) * nx + rel.cubes[:, 0]
+        nb = np.array(spline.shape[::-1]) // B + 1
+        # proxy_units orders blocks lexicographically (x, then y, then z): a key in the same order
+        key = lambda c: (c[:, 0] * nb[1] + c[:, 1]) * nb[2] + c[:, 2]  # noqa: E731
+        bkey = key(first // B)
+        block_id = np.searchsorted(bkey, key(rel.cubes // B))
+        a = rel.cubes - (rel.cubes // B) * B
+        k = block_id * B ** 3 + (a[:, 2] * B + a[:, 1]) * B + a[:, 0]
         rows = _table_rows(rel)
         info[k, 0] = rel.masks
         info[k, 1] = rows >> 12
@@ -249,7 +260,12 @@ def proxy_units(spline: VolumeSpline, rel: Relevant, proxy: str, block_size: int
     """The proxy boxes as (first cube (n, 3) int, cubes per axis (n, 3) int), in drawing order."""
     if proxy == "blocks":
         B = block_size
-        first = np.unique(rel.cubes // B, axis=0) * B if len(rel.cubes) else np.zeros((0, 3), np.int64)
+        if not len(rel.cubes):
+            return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.int64)
+        nb = np.array(spline.shape[::-1]) // B + 1
+        bc = rel.cubes // B
+        key = np.unique((bc[:, 0] * nb[1] + bc[:, 1]) * nb[2] + bc[:, 2])  # 1-D unique: (x, y, z) lexicographic
+        first = np.column_stack([key // (nb[1] * nb[2]), (key // nb[2]) % nb[1], key % nb[2]]) * B
         return first, np.minimum(B, np.array(spline.shape[::-1]) - first)
     return rel.cubes, np.ones_like(rel.cubes)
 
@@ -262,7 +278,7 @@ def _proxies(spline: VolumeSpline, rel: Relevant, encoding: str, proxy: str = "c
         local = _CORNERS[None] * ext[:, None, :]  # block-local corner coordinates, cube units
         corners = (first[:, None, :] - 0.5 + local) * spline.spacing
         tris = (np.arange(n)[:, None, None] * 8 + _BOX_TRIS[None]).reshape(-1, 3)
-        cube_attr = np.repeat(np.column_stack([first, np.zeros(n)]).astype(np.float64), 8, axis=0)
+        cube_attr = np.repeat(np.column_stack([first, np.arange(n)]).astype(np.float64), 8, axis=0)  # .w = block id
         attributes = {"sv_cube": cube_attr}
         return corners.reshape(-1, 3), tris, attributes, {"sv_local": local.reshape(-1, 3)}
     n = len(rel.cubes)
@@ -303,7 +319,7 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     points, tris, attributes, varyings = _proxies(spline, rel, encoding, "blocks" if blocks else "cubes", B)
     actor.set_geometry(points, tris, {**attributes, **varyings})
     if blocks:
-        actor.set_texture("sv_volume_mask", mask_texture(spline, rel))
+        actor.set_texture("sv_volume_mask", mask_texture(spline, rel, B))
     if encoding == "coefficients":
         actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
     actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)
