@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.parametrize("module", [
     "splinevis.gl.assembler", "splinevis.effects", "splinevis.analytic.patch", "splinevis.gl.headless",
-    "splinevis.plotting",
+    "splinevis.plotting", "splinevis.volume.model",
 ])
 def test_docstring_examples_run(module):
     mod = importlib.import_module(module)

@@ -5,6 +5,8 @@
   ways round (the surface writes ``gl_FragDepth``).
 * ``effects.png`` -- the same patch under each effect set; every panel compiled only its own effects.
 * ``composite_check.png`` -- which surface is in front per pixel, GPU against the float64 reference.
+* ``volume.png`` -- Marschner-Lobb 41^3, close-up: marching cubes (flying edges), VTK's GPU isosurface ray
+  caster, the quadratic and the cubic spline ray-cast per pixel; second row with reflection lines.
 * ``terrain.png`` -- a synthetic DEM (UTM-sized origin) as a C1 quartic spline: colour by height with
   reflection lines, beside the same data as a linear mesh and as the C2 box spline.
 """
@@ -87,7 +89,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _effect_panels()
-    steps = tqdm(total=3 + len(panels), desc="showcase", disable=not progress, unit="fig")
+    steps = tqdm(total=4 + len(panels), desc="showcase", disable=not progress, unit="fig")
     written = {}
 
     pl, patch, _ = composite_scene()
@@ -141,6 +143,12 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     path = out / "terrain.png"
     _terrain_figure(path)
     written["terrain"] = path
+    steps.update()
+    from .volume import side_by_side_figure
+
+    path = out / "volume.png"
+    side_by_side_figure(path)
+    written["volume"] = path
     steps.update()
     steps.close()
     return written
