@@ -8,6 +8,9 @@ Cases
   surface with 10^3 .. 10^6 triangles, same camera, 800x600, anti-aliasing off.
 * ``effect_sets``: frame time of the ray-cast patch under each effect set (only the declared effects
   are compiled in, so the cost of an effect is the difference to the baseline).
+* ``volume``: isosurface of Marschner-Lobb 64^3 in a full view and a close-up: spline programs (quadratic /
+  cubic, block / cube proxies, data / coefficient encoding, culling on / off) side by side with a flying-edges
+  marching cubes mesh and VTK's GPU isosurface ray caster of the same data.
 * ``terrain``: the terrain ray caster on 65x65 .. 1025x1025 grids in one full-screen view, with the
   min/max hierarchy on and off (the hierarchical equivalent of the paper's front-to-back occlusion sets).
 
@@ -136,6 +139,52 @@ def bench_terrain(repeats, quick):
     return rows
 
 
+VOLUME_VIEWS = {"full": [(2.6, -2.2, 2.0), (0.0, 0.0, 0.0), (0, 0, 1)],
+                "close-up": [(0.9, 0.7, 0.9), (0.3, 0.2, 0.3), (0, 0, 1)]}
+
+
+def bench_volume(repeats, quick):
+    """Volume isosurfaces: what each program choice costs per frame, against the users' tools."""
+    from datasets_synthetic.volumes import marschner_lobb
+    from splinevis.plotting import Plotter
+    from splinevis.volume.baselines import add_vtk_isosurface, marching_cubes_mesh
+    from splinevis.volume.model import VolumeSpline
+
+    field = marschner_lobb()
+    grid = field.sample(64)
+    iso = field.isovalue
+    splines = {s: VolumeSpline(grid, s) for s in ("quadratic", "cubic")}
+    configs = [("marching cubes (flying edges, 1x)", None, {}), ("VTK ray caster (sample h/4)", None, {}),
+               ("quadratic, blocks, data", "quadratic", {}), ("cubic, blocks, data", "cubic", {})]
+    if not quick:
+        configs += [("quadratic, cubes, data", "quadratic", {"proxy": "cubes"}),
+                    ("quadratic, blocks, coefficients", "quadratic", {"encoding": "coefficients"}),
+                    ("quadratic, blocks, no culling", "quadratic", {"culling": False})]
+    rows = []
+    for view, cam in VOLUME_VIEWS.items():
+        for name, scheme, opts in configs:
+            pl = Plotter(off_screen=True, window_size=WINDOW)
+            opts = dict(opts)
+            culling = opts.pop("culling", True)
+            if scheme is not None:
+                pl.add_isosurface(splines[scheme], iso, lights=1, culling=culling, program_options=opts)
+            elif name.startswith("marching"):
+                pl.add_mesh(marching_cubes_mesh(grid, iso, method="flying_edges"), color="tan", smooth_shading=True)
+            else:
+                add_vtk_isosurface(pl, grid, iso, sample_distance=grid.spacing[0] / 4)
+            pl.camera_position = cam
+            pl.camera.view_angle = 30
+            pl.camera.clipping_range = (0.01, 10.0)
+            r = _time_frames(pl, repeats)
+            pl.close()
+            rows.append({"view": view, "program": name, **r})
+        base = next(r["median_ms"] for r in rows if r["view"] == view and r["program"].startswith("marching"))
+        for r in rows:
+            if r["view"] == view:
+                r["ratio_to_mesh"] = r["median_ms"] / base
+    return rows
+
+
 def _markdown(results):
     lines = [f"# splinevis benchmarks\n\n{results['machine']}\n"]
     lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
@@ -154,6 +203,12 @@ def _markdown(results):
     for r in results["terrain"]:
         lines.append(f"| {r['grid']} | {r['patches']:,} | {'min/max quadtree' if r['hierarchy'] else 'off (cell walk)'} | "
                      f"{r['screen_covered']:.2f} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_smallest_grid']:.2f} |")
+    if "volume" in results:
+        lines.append("\n## Volume isosurfaces: Marschner-Lobb 64^3 (same data, same views)\n")
+        lines.append("| view | program | min ms | median ms | median / marching cubes |")
+        lines.append("|---|---|---:|---:|---:|")
+        for r in results["volume"]:
+            lines.append(f"| {r['view']} | {r['program']} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_mesh']:.1f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -170,7 +225,8 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
-    cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain)]
+    cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
+             ("volume", bench_volume)]
     for name, fn in tqdm(cases, desc="benchmarks"):
         results[name] = fn(args.repeats, args.quick)
     out = Path(args.out)

@@ -627,7 +627,8 @@ def _markdown(result) -> str:
     md.append("\n## 3. Memory and preprocessing (Marschner-Lobb, isovalue 0.5; layout of the paper's Table 1)\n")
     md.append(_md_table(result["memory"], [
         ("volume", "volume", "s"), ("scheme", "scheme", "s"), ("cubes", "relevant_cubes", "int"),
-        ("tets", "relevant_tets", "int"), ("geometry MB", "geometry_MB", "f2"), ("data texture MB", "data_texture_MB", "f2"),
+        ("tets", "relevant_tets", "int"), ("geometry MB (blocks)", "geometry_MB", "f2"),
+        ("geometry MB (cube proxies)", "geometry_cubes_MB", "f2"), ("data texture MB", "data_texture_MB", "f2"),
         ("determining set MB", "determining_set_MB", "f2"), ("all coefficients MB", "all_coefficients_MB", "f2"),
         ("coef. table MB", "coefficient_table_MB", "f2"), ("octree MB", "octree_MB", "f2"),
         ("spline s", "spline_s", "f2"), ("octree s", "octree_s", "f2"), ("relevant s", "relevant_s", "f2"),

@@ -119,16 +119,21 @@ def coefficient_table(spline: VolumeSpline, relevant: Relevant):
     return _linear_texture(out), rows
 
 
-def memory_report(spline: VolumeSpline, relevant: Relevant) -> dict:
-    """Bytes of each part for one isovalue: bounding geometry (proxy vertices, attributes, indices as VTK
-    uploads them), the data texture, the coefficient table, and the octree."""
+def memory_report(spline: VolumeSpline, relevant: Relevant, block_size: int = BLOCK_SIZE) -> dict:
+    """Bytes of each part for one isovalue: bounding geometry as VTK uploads it (float32 points, the flat
+    and interpolated attributes, int indices) for the default block proxies (plus their per-cube info
+    texture) and for cube proxies, the data texture, the coefficient table, every coefficient, the paper's
+    determining sets (20 / 56 floats per cube), and the octree."""
     n = len(relevant.cubes)
     m = spline.ncoef
-    geometry = n * (8 * (3 * 4 + 4 * 4 + 3 * 4) + 12 * 3 * 4)  # float32 points + sv_cube + sv_local, int indices
+    per_box = 8 * (3 * 4 + 4 * 4 + 3 * 4) + 12 * 3 * 4  # points + sv_cube + sv_local; 12 triangles
+    blocks, _ = proxy_units(spline, relevant, "blocks", block_size)
     return {
         "relevant_cubes": n,
         "relevant_tets": relevant.num_tets,
-        "geometry_bytes": geometry,
+        "proxy_blocks": len(blocks),
+        "geometry_bytes": len(blocks) * (per_box + block_size ** 3 * 16),
+        "geometry_cubes_bytes": n * (per_box + 8 * 3 * 4),  # + sv_cube_extra
         "data_texture_bytes": int(np.prod(spline.padded.shape)) * 4,
         "coefficient_table_bytes": relevant.num_tets * m * 4,
         "all_coefficients_bytes": n * 24 * m * 4,
