@@ -144,7 +144,9 @@ VOLUME_VIEWS = {"full": [(2.6, -2.2, 2.0), (0.0, 0.0, 0.0), (0, 0, 1)],
 
 
 def bench_volume(repeats, quick):
-    """Volume isosurfaces: what each program choice costs per frame, against the users' tools."""
+    """Volume isosurfaces: what each program choice costs per frame, against the users' tools (at most 3
+    repeats: a spline frame takes seconds at 800x600 on llvmpipe)."""
+    repeats = min(repeats, 3)
     from datasets_synthetic.volumes import marschner_lobb
     from splinevis.plotting import Plotter
     from splinevis.volume.baselines import add_vtk_isosurface, marching_cubes_mesh
