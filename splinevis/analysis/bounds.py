@@ -59,18 +59,7 @@ def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, co
         return np.einsum("...i,...i->...", gradient(q[..., :2]), d[..., :2]) - d[..., 2]
 
     gsecond = np.abs(slope(t + h) - slope(t - h)) / (2 * h)
-    simple = 2.0 * gsecond * eps < gprime ** 2
-    dt = np.where(simple, 2.0 * eps / np.maximum(gprime, 1e-300),
-                  2.0 * np.sqrt(2.0 * eps / np.maximum(gsecond, 1e-300)))
-    dd_dt = np.abs(window_depth(matrix, o + (t + h)[..., None] * d) - window_depth(matrix, o + (t - h)[..., None] * d)) / (2 * h)
-    m = np.asarray(matrix, dtype=np.float64)
-    ph = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1)
-    w = ph @ m[3]
-    ndc = (ph @ m[2]) / w
-    s2 = np.abs(ph * m[2]).sum(axis=-1)
-    s3 = np.abs(ph * m[3]).sum(axis=-1)
-    depth_arith = 0.5 * (4.0 * U32 * (s2 + np.abs(ndc) * s3) / np.abs(w) + U32) + U32
-    return dd_dt * dt + depth_arith + 2.0 ** -24
+    return _depth_error(matrix, o, d, t, h, _root_shift(eps, gprime, gsecond))
 
 
 def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matrix, origins, directions, t,
@@ -113,10 +102,23 @@ def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matri
         return np.einsum("...i,...i->...", value_and_gradient(q)[1], d)
 
     gsecond = np.abs(slope(t + dl) - slope(t - dl)) / (2 * dl)
+    dt = _root_shift(eps, gprime, gsecond) + 4.0 * U32 * model_extent / np.linalg.norm(d, axis=-1)
+    return _depth_error(matrix, o, d, t, dl, dt)
+
+
+def _root_shift(eps, gprime, gsecond):
+    """Bound on the move of a root of g when g is perturbed by at most eps: 2 eps / |g'| for simple roots
+    (2 |g''| eps < g'^2), else 2 sqrt(2 eps / |g''|) (near-tangential rays, double roots)."""
     simple = 2.0 * gsecond * eps < gprime ** 2
-    dt = np.where(simple, 2.0 * eps / np.maximum(gprime, 1e-300), 2.0 * np.sqrt(2.0 * eps / np.maximum(gsecond, 1e-300)))
-    dt = dt + 4.0 * U32 * model_extent / np.linalg.norm(d, axis=-1)
-    dd_dt = np.abs(window_depth(matrix, o + (t + dl)[..., None] * d) - window_depth(matrix, o + (t - dl)[..., None] * d)) / (2 * dl)
+    return np.where(simple, 2.0 * eps / np.maximum(gprime, 1e-300), 2.0 * np.sqrt(2.0 * eps / np.maximum(gsecond, 1e-300)))
+
+
+def _depth_error(matrix, o, d, t, h, dt):
+    """Window-depth error of a hit at ray parameter t known to within dt: |d depth/dt| dt, plus the float32
+    clip-space arithmetic (clip z and w are 4-term dot products, 4 u sum |M_ij p_j| each; ndc = z / w; window
+    depth = half of it plus a rounding) and the 2^-24 depth-buffer quantization."""
+    p = o + t[..., None] * d
+    dd_dt = np.abs(window_depth(matrix, o + (t + h)[..., None] * d) - window_depth(matrix, o + (t - h)[..., None] * d)) / (2 * h)
     m = np.asarray(matrix, dtype=np.float64)
     ph = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1)
     w = ph @ m[3]

@@ -41,7 +41,7 @@ import itertools
 import numpy as np
 
 from ..bb import simplex as bb
-from .partition import NUM_TETS, _bary_mats, _tets
+from .partition import NUM_TETS, _bary_mats, _inner_faces, _tets
 from .schemes import _BIG_ID, STENCIL, _lift, spline_coefficients
 
 __all__ = ["NUM_DOMAIN_POINTS", "domain_points", "determining_set", "inner_face_conditions", "derive_weights",
@@ -97,18 +97,6 @@ def determining_set() -> np.ndarray:
     """Indices (into :func:`domain_points`) of the 56 points of the determining set D3 (paper 003, Fig. 4):
     cube vertices, edge points, centroids of the 24 boundary triangles; increasing order."""
     return _determining().copy()
-
-
-@functools.lru_cache(maxsize=None)
-def _inner_faces():
-    v = _tets()
-    out = []
-    for t in range(NUM_TETS):
-        for s in range(t + 1, NUM_TETS):
-            shared = [w for w in v[t] if any(np.array_equal(w, z) for z in v[s])]
-            if len(shared) == 3:
-                out.append((t, s, np.array(shared)))
-    return out
 
 
 @functools.lru_cache(maxsize=None)

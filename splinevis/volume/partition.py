@@ -56,6 +56,19 @@ def _tets() -> np.ndarray:
     return out
 
 
+@functools.lru_cache(maxsize=None)
+def _inner_faces():
+    """The 36 faces shared by two tetrahedra of one cube: ``[(t, s, (3, 3) shared vertices), ...]``, t < s."""
+    v = _tets()
+    out = []
+    for t in range(NUM_TETS):
+        for s in range(t + 1, NUM_TETS):
+            shared = [w for w in v[t] if any(np.array_equal(w, z) for z in v[s])]
+            if len(shared) == 3:
+                out.append((t, s, np.array(shared)))
+    return out
+
+
 def type6_tetrahedra() -> np.ndarray:
     """Vertices of the 24 tetrahedra, shape ``(24, 4, 3)``: ``[vQ, wF, u, u']`` in the documented order."""
     return _tets().copy()

@@ -48,7 +48,7 @@ import numpy as np
 
 from .._validation import as_float64_array
 from ..bb import simplex as bb
-from .partition import NUM_TETS, _bary_mats, _locate, _tets
+from .partition import NUM_TETS, _bary_mats, _inner_faces, _locate, _tets
 
 __all__ = ["domain_points", "edge_points", "inner_face_conditions", "derive_weights",
            "quadratic_super_spline", "evaluate", "NUM_DOMAIN_POINTS", "STENCIL", "SCHEMES", "pad_volume",
@@ -96,18 +96,6 @@ def _face_points():
 
 def _idx(x):
     return _domain()[2][tuple(int(v) for v in np.round(4 * np.asarray(x)))]
-
-
-@functools.lru_cache(maxsize=None)
-def _inner_faces():
-    v = _tets()
-    out = []
-    for t in range(NUM_TETS):
-        for s in range(t + 1, NUM_TETS):
-            shared = [w for w in v[t] if any(np.array_equal(w, z) for z in v[s])]
-            if len(shared) == 3:
-                out.append((t, s, np.array(shared)))
-    return out
 
 
 def inner_face_conditions():
