@@ -1,0 +1,92 @@
+"""Reflection lines on ordinary meshes, from the same GLSL file the spline programs use.
+
+A marching cubes or other triangle mesh shaded with its interpolated vertex normals shows what users see
+today; to compare surface quality with the ray-cast splines side by side, the mesh gets the very same
+stripes: ``glsl/lib/effects/reflection_lines.glsl`` evaluated per fragment on the mirrored view ray of the
+interpolated (model-space) vertex normal, multiplied into VTK's own lighting. Facets and normal kinks of the
+mesh then show as kinks in the stripes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from vtkmodules.vtkCommonCore import VTK_OBJECT
+
+from .assembler import assemble
+from .inject import _set_uniform
+
+__all__ = ["add_mesh_with_reflection_lines"]
+
+_VS_DEC = """//VTK::Normal::Dec
+out vec3 svMeshPosMC;
+out vec3 svMeshNormalMC;
+"""
+_VS_IMPL = """//VTK::Normal::Impl
+  svMeshPosMC = vertexMC.xyz;
+  svMeshNormalMC = normalMC;
+"""
+_FS_DEC = """//VTK::Normal::Dec
+in vec3 svMeshPosMC;
+in vec3 svMeshNormalMC;
+uniform vec3 sv_eye_mc;
+"""
+_FS_LIGHT = """//VTK::Light::Impl
+  {
+    vec3 sv_rd = normalize(svMeshPosMC - sv_eye_mc);
+    vec3 sv_n = normalize(svMeshNormalMC);
+    if (dot(sv_n, sv_rd) > 0.0) sv_n = -sv_n;  // two-sided, as lib/shading.glsl
+    fragOutput0.rgb *= sv_reflection_lines(reflect(sv_rd, sv_n));
+  }
+"""
+
+
+def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", ambient: float = 0.15,
+                                   diffuse: float = 0.85):
+    """Add ``mesh`` (point normals are used, e.g. from marching cubes; computed if absent) to ``plotter``,
+    Phong-shaded with VTK's lights, with ``stripes`` reflection lines computed as for the splines
+    (``Style(reflection_lines=stripes)``). The mesh is in world coordinates (no actor transform).
+
+    Returns the vtkActor. (A vtkOpenGLPolyDataMapper of our own: pyvista's DataSetMapper renders through
+    an internal mapper whose shader events it does not forward.)
+    """
+    import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkCommand
+    from vtkmodules.vtkRenderingCore import vtkActor
+    from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
+
+    if isinstance(stripes, bool) or not isinstance(stripes, (int, np.integer)) or stripes < 1:
+        raise ValueError(f"stripes must be a positive integer, got {stripes!r}.")
+    mesh = pv.wrap(mesh).extract_surface(algorithm=None) if not isinstance(mesh, pv.PolyData) else mesh
+    if mesh.point_data.get("Normals") is None:
+        mesh = mesh.compute_normals(cell_normals=False, split_vertices=False)
+    mesh.point_data.active_normals_name = "Normals"
+    mapper = vtkOpenGLPolyDataMapper()
+    mapper.SetInputData(mesh)
+    mapper.ScalarVisibilityOff()
+    actor = vtkActor()
+    actor.SetMapper(mapper)
+    prop = actor.GetProperty()
+    prop.SetColor(*pv.Color(color).float_rgb)
+    prop.SetInterpolationToPhong()
+    prop.SetAmbient(ambient)
+    prop.SetDiffuse(diffuse)
+    code = assemble('#include "lib/effects/reflection_lines.glsl"\n', {}).text
+    sp = actor.GetShaderProperty()
+    sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, _VS_DEC, False)
+    sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, _VS_IMPL, False)
+    sp.AddFragmentShaderReplacement("//VTK::Normal::Dec", True, _FS_DEC + code, False)
+    sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
+    renderer = plotter.renderer
+
+    def update(caller, event, program=None):
+        if program is None:
+            return
+        eye = np.array(renderer.GetActiveCamera().GetPosition(), dtype=np.float64)
+        _set_uniform(program, "sv_eye_mc", eye)
+        _set_uniform(program, "sv_stripes", float(stripes))
+
+    update.CallDataType = VTK_OBJECT
+    mapper.AddObserver(vtkCommand.UpdateShaderEvent, update)
+    actor._sv_update = update  # keep the callback alive with the actor
+    plotter.add_actor(actor, reset_camera=True)
+    return actor
