@@ -104,8 +104,9 @@ def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     assert wrong.mean() + (ref_hit & ~gpu_hit).sum() / ref_hit.sum() <= 0.05
 
 
-@pytest.mark.parametrize("options", [{}, {"roots": "bracketed"}, {"proxy": "cubes"}],
-                         ids=["analytic", "bracketed", "cubes"])
+@pytest.mark.parametrize("options", [{}, {"roots": "bracketed"}, {"proxy": "cubes"}, {"encoding": "determining"},
+                                     {"encoding": "determining", "proxy": "cubes"}],
+                         ids=["analytic", "bracketed", "cubes", "determining-set", "determining-set-cubes"])
 def test_cubic_sphere_matches_twin(options):
     assert "cubic" in SCHEME_DEGREE
     iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
@@ -208,6 +209,8 @@ def test_options_are_validated():
         isosurface_program(iso, roots="cardano")
     with pytest.raises(ValueError, match="for quadratics the paper"):
         isosurface_program(iso, roots="paper")
+    with pytest.raises(ValueError, match="56 determining coefficients"):
+        isosurface_program(iso, encoding="determining")
     with pytest.raises(ValueError, match="isovalue must be finite"):
         Isosurface(iso.spline, float("nan"))
 

@@ -115,6 +115,57 @@ def _symmetries():
     return out
 
 
+def _sigmas():
+    """For every tetrahedron t the cube symmetry (3, 3) mapping tetrahedron 0's vertices onto t's in order."""
+    from splinevis.volume.partition import type6_tetrahedra
+
+    V = type6_tetrahedra() - 0.5
+    out = []
+    for t in range(24):
+        for m in _symmetries():
+            if np.allclose(V[0] @ m.T, V[t]):
+                out.append(m)
+                break
+        else:
+            raise ValueError(f"no cube symmetry maps tetrahedron 0 onto tetrahedron {t} in vertex order.")
+    return out
+
+
+def determining(scheme: str = "cubic") -> str:
+    """``sv_tet_coefficients_det(t, d, b)``: tetrahedron t's coefficients from the cube's 56 determining
+    coefficients d (paper 003 sec. 5.1 encoding), by tetrahedron 0's map applied to the determining points
+    permuted by the symmetry sigma_t (verified)."""
+    from splinevis.volume.cubic import determining_map, determining_set, domain_points
+
+    M, _ = determining_map()  # (24, 20, 56)
+    pts = domain_points()[0][determining_set()] - 0.5
+    index = {tuple(np.round(4 * p).astype(int)): k for k, p in enumerate(pts)}
+    perms = np.empty((24, len(pts)), dtype=np.int64)
+    for t, m in enumerate(_sigmas()):
+        perms[t] = [index[tuple(np.round(4 * (m @ p)).astype(int))] for p in pts]
+        if not np.allclose(M[t][:, perms[t]], M[0], atol=1e-12):
+            raise ValueError(f"the determining map of tetrahedron {t} is not the symmetric image of tetrahedron 0's.")
+    nd = len(pts)
+    table = ", ".join(str(int(v)) for v in perms.ravel())
+    out = [HEAD, f"// {scheme}: BB coefficients of tetrahedron t from the cube's {nd} determining coefficients d (paper 003\n"
+           "// sec. 5.1: only the determining set is stored; the other coefficients follow by the smoothness\n"
+           "// conditions, here tetrahedron 0's linear map on the determining points permuted by sigma_t).\n",
+           f"const int SV_DET_COUNT = {nd};\nconst int SV_DET_PERM[{24 * nd}] = int[{24 * nd}]({table});\n\n",
+           f"void sv_tet_coefficients_det(int t, float d[{nd}], out float b[{M.shape[1]}]) {{\n    float g[{nd}];\n"
+           f"    for (int k = 0; k < {nd}; ++k) g[k] = d[SV_DET_PERM[{nd} * t + k]];\n"]
+    for q in range(M.shape[1]):
+        groups: dict = {}
+        for k in np.nonzero(np.abs(M[0, q]) > 1e-14)[0]:
+            groups.setdefault(round(float(M[0, q, k]), 15), []).append(int(k))
+        parts = []
+        for val, ks in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
+            ssum = " + ".join(f"g[{k}]" for k in ks)
+            parts.append(f"{_f(val)} * ({ssum})" if len(ks) > 1 else f"{_f(val)} * {ssum}")
+        out.append(f"    b[{q}] = " + " + ".join(parts) + ";\n")
+    out.append("}\n")
+    return "".join(out)
+
+
 def stencil_permutations(W: np.ndarray) -> np.ndarray:
     """(24, 27) int: for tetrahedron t, the symmetry sigma_t of the cube mapping tetrahedron 0's vertices
     [vQ, wF, u, u'] in order onto tetrahedron t's, as a permutation of the 27 stencil offsets, such that
@@ -173,6 +224,7 @@ def generate() -> dict:
     files = {"type6.glsl": type6(), "tet_steps.glsl": tet_steps()}
     for scheme in SCHEME_DEGREE:
         files[f"volume_stencil_{scheme}.glsl"] = stencil(scheme)
+    files["volume_determining_cubic.glsl"] = determining("cubic")
     return files
 
 

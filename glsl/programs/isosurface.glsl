@@ -25,6 +25,14 @@
 #else
 #include "lib/volume_stencil_quadratic.glsl"
 #endif
+#ifdef SV_VOLUME_DETERMINING
+// Paper 003's encoding: per relevant cube only its 56 determining coefficients (sampler sv_volume_det, one
+// row of 56 floats per cube); the rest follow from them in the shader.
+#include "lib/volume_determining_cubic.glsl"
+const int SV_CUBE_VALUES = 56;
+#else
+const int SV_CUBE_VALUES = 27;
+#endif
 
 uniform vec3 sv_inv_spacing;      // index-space direction = sv_inv_spacing * model-space direction
 uniform float sv_iso_shifted;     // isovalue - sv_value_ref (the textures hold data - sv_value_ref)
@@ -52,8 +60,10 @@ float sv_fetch_color(int n) {
 
 float sv_fetch_linear(int n) {
     int texel = n / 4;
-#ifdef SV_VOLUME_TABLE
+#if defined(SV_VOLUME_TABLE)
     vec4 v = texelFetch(sv_volume_coef, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+#elif defined(SV_VOLUME_DETERMINING)
+    vec4 v = texelFetch(sv_volume_det, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
 #else
     vec4 v = texelFetch(sv_volume_data, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
 #endif
@@ -62,12 +72,16 @@ float sv_fetch_linear(int n) {
 
 #ifdef SV_VOLUME_TABLE
 // Coefficients of tetrahedron t from row `r` of the table (the cube's first row + the tetrahedron's rank).
-void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
+void sv_load_tet(int t, int r, float f[SV_CUBE_VALUES], out float b[SV_VOL_NCOEF]) {
     int base = r * SV_VOL_NCOEF;
     for (int q = 0; q < SV_VOL_NCOEF; ++q) b[q] = sv_fetch_linear(base + q);
 }
+#elif defined(SV_VOLUME_DETERMINING)
+void sv_load_tet(int t, int r, float f[SV_CUBE_VALUES], out float b[SV_VOL_NCOEF]) {
+    sv_tet_coefficients_det(t, f, b);
+}
 #else
-void sv_load_tet(int t, int r, float f[27], out float b[SV_VOL_NCOEF]) {
+void sv_load_tet(int t, int r, float f[SV_CUBE_VALUES], out float b[SV_VOL_NCOEF]) {
     sv_tet_coefficients(t, f, b);
 }
 #endif
@@ -92,9 +106,13 @@ void sv_load_stencil_of(ivec3 c, int field, out float f[27]) {
     }
 }
 
-void sv_load_stencil(ivec3 c, out float f[27]) {
-#ifdef SV_VOLUME_TABLE
-    for (int s = 0; s < 27; ++s) f[s] = 0.0;
+// What the shader reads once per cube: the 27 data values (encoding "data"), the cube's determining
+// coefficients (row `row` of the determining table), or nothing (the coefficient table is read per tet).
+void sv_load_cube(ivec3 c, int row, out float f[SV_CUBE_VALUES]) {
+#if defined(SV_VOLUME_TABLE)
+    for (int s = 0; s < SV_CUBE_VALUES; ++s) f[s] = 0.0;
+#elif defined(SV_VOLUME_DETERMINING)
+    for (int k = 0; k < SV_CUBE_VALUES; ++k) f[k] = sv_fetch_linear(row * SV_CUBE_VALUES + k);
 #else
     sv_load_stencil_of(c, 0, f);
 #endif
@@ -170,7 +188,7 @@ vec2 sv_tet_curvature(float b[SV_VOL_NCOEF], int t, vec4 l, vec3 g) {
 
 // First hit (smallest t >= tmin) inside cube c along the cube-local ray P0 + t D over the cube's relevant
 // tetrahedra (mask); returns SV_NO_HIT if none, else t with the tetrahedron and its rank in the table.
-float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin, float f[27],
+float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin, float f[SV_CUBE_VALUES],
                         out int tet_best, out int rank_best) {
     float t_best = SV_NO_HIT;
     tet_best = -1;
@@ -228,7 +246,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.curvature = vec2(0.0);
     hit.depth = 0.0;
     vec3 D = sv_inv_spacing * rd;   // index units per unit of t (t is the model-space parameter of ro + t rd)
-    float f[27];
+    float f[SV_CUBE_VALUES];
     float t_best = SV_NO_HIT;
     int tet_best = -1;
     int rank_best = 0;
@@ -272,7 +290,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         if (mask != 0) {
             int crow = 4096 * int(info.g) + int(info.b);
             vec3 Pc = Pb - vec3(a);
-            sv_load_stencil(cc, f);
+            sv_load_cube(cc, crow, f);
             int tb_tet;
             int tb_rank;
             // tetrahedra are clipped by their own (margin-widened) barycentric extent, not by the block's
@@ -302,7 +320,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     // The ray in cube-local coordinates: the interpolated local position of this fragment (exact at the
     // proxy's corners).
     P0 = sv_localVSOut;
-    sv_load_stencil(c, f);
+    sv_load_cube(c, row, f);
     t_best = sv_cube_first_hit(c, mask, row, P0, D, tmin, f, tet_best, rank_best);
     if (tet_best < 0) return false;
 #endif

@@ -404,7 +404,8 @@ def spline_configs(quick, cubic):
     (``"paper"``) exists for the cubic only: the paper solves quadratics in closed form."""
     q = [("quadratic", "data", "analytic", 1, "blocks"), ("quadratic", "coefficients", "analytic", 1, "blocks"),
          ("quadratic", "data", "analytic", 1, "cubes")]
-    c = [("cubic", "data", "analytic", 1, "blocks"), ("cubic", "data", "paper", 5, "blocks"),
+    c = [("cubic", "data", "analytic", 1, "blocks"), ("cubic", "determining", "analytic", 1, "blocks"),
+         ("cubic", "data", "paper", 5, "blocks"),
          ("cubic", "data", "bracketed", 2, "blocks")]
     if not quick:
         q += [("quadratic", "data", "bracketed", 2, "blocks"), ("quadratic", "data", "bracketed", 4, "blocks")]
@@ -455,7 +456,7 @@ def _short(r):
         return f"{r['upsample']}x"
     if r["method"] == "VTK volume":
         return r["config"].replace("sample distance ", "")
-    return (("" if r.get("proxy", "blocks") == "blocks" else "cubes ") + ("D" if r["encoding"] == "data" else "C") + "/"
+    return (("" if r.get("proxy", "blocks") == "blocks" else "cubes ") + {"data": "D", "coefficients": "C"}.get(r["encoding"], "S") + "/"
             + r["roots"][:2] + ("" if r["iterations"] is None else str(r["iterations"])))
 
 
@@ -494,7 +495,7 @@ def pareto_figure(rows, setup, path):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle(f"Accuracy vs time: {setup['field']}, {setup['grid']} samples (h = {setup['h']:.4f}); spline labels: "
-                 "D/C = data texture / coefficient table, an = closed form, br = bracketed, pa = paper's Newton + iterations",
+                 "D/C/S = data texture / coefficient table / determining set, an = closed form, br = bracketed, pa = paper's Newton + iterations",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)

@@ -277,7 +277,7 @@ def _weights():
     inner_res = float(np.abs(A @ W).max())
     cube_res = _cube_face_residual(W)
     W.setflags(write=False)
-    return W, ncons, ncls, inner_res, cube_res, pairs, shift, quad_res
+    return W, ncons, ncls, inner_res, cube_res, pairs, shift, quad_res, M, K
 
 
 def _cube_face_residual(W):
@@ -302,6 +302,16 @@ def _cube_face_residual(W):
     return worst
 
 
+def determining_map():
+    """The determining-set encoding of the scheme (paper 003 sec. 5.1): ``(M (24, 20, 56), K (56, 27))`` with
+    the 56 determining coefficients of a cube ``d = K @ data27`` (its masks, Fig. 4) and every tetrahedron's
+    coefficients ``M[t] @ d`` (the inner C1 conditions solved for the other 119 points: "repeated averaging",
+    Fig. 7). ``M[t] @ K`` equals :func:`splinevis.volume.schemes.tet_weights` ("cubic")[t] up to rounding."""
+    _, _, _, _, _, _, _, _, M, K = _weights()
+    _, tmap = domain_points()
+    return M[tmap].copy(), K.copy()
+
+
 def derive_weights() -> dict:
     """The coefficient map of the cubic C1 scheme and its diagnostics.
 
@@ -320,7 +330,7 @@ def derive_weights() -> dict:
         ``"quadratic_reproduction_residual"``: residual of the mask system with s = 0 (> 0: exact
         reproduction of quadratics is impossible with these masks).
     """
-    W, ncons, ncls, inner_res, cube_res, pairs, shift, quad_res = _weights()
+    W, ncons, ncls, inner_res, cube_res, pairs, shift, quad_res, _, _ = _weights()
     return {"W": W.copy(), "determining_set": _determining().copy(), "consistency_conditions": ncons,
             "mask_parameters": ncls, "inner_residual": inner_res, "cube_face_residual": cube_res,
             "exact_faces": list(pairs) if inner_res < 1e-12 else [], "square_shift": shift,

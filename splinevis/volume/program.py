@@ -10,6 +10,9 @@ Data streams (paper 003, sec. 5.1), two encodings selectable for measurement:
   themselves averages of the data; storing the data is 1 value per cube.
 * ``encoding="coefficients"``: every BB coefficient of every relevant tetrahedron in a table (the "direct
   approach" the paper compares with), rebuilt for every isovalue.
+* ``encoding="determining"`` (cubic): paper 003's own encoding, the 56 determining coefficients of every
+  relevant cube (Fig. 4 masks); the shader derives the other 119 from them (generated
+  glsl/lib/volume_determining_cubic.glsl).
 
 Bounding geometry: one box per relevant cube (8 vertices, 12 triangles), with flat attributes
 ``sv_cube = (i, j, k, low 12 bits of the tet mask)``, ``sv_cube_extra = (high 12 bits of the mask, row of the
@@ -152,8 +155,9 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     model : Isosurface
     newton_iterations : int, 1..8
         Iterations of the Newton-type root finders (cubic, or ``roots != "analytic"``).
-    encoding : {"data", "coefficients"}
-        Where the shader gets BB coefficients from (module docstring).
+    encoding : {"data", "coefficients", "determining"}
+        Where the shader gets BB coefficients from (module docstring); ``"determining"`` (cubic only) is
+        paper 003's encoding: the 56 determining coefficients per relevant cube.
     roots : {"analytic", "bracketed", "paper"}, default "analytic"
         ``"analytic"``: the stable closed form (quadratic formula; for the cubic the trigonometric/Cardano
         form on the BB coefficients, ``sv_first_root_cubic``); ``"bracketed"``: bracketed Newton on convex
@@ -172,10 +176,14 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")
     spline = model.spline
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
-    check_choice(encoding, "encoding", {"data", "coefficients"})
+    check_choice(encoding, "encoding", {"data", "coefficients", "determining"})
     check_choice(proxy, "proxy", {"blocks", "cubes"})
     block_size = check_degree(block_size, "block_size", low=1, high=16)
     cubic = spline.degree == 3
+    if encoding == "determining" and not cubic:
+        raise ValueError("encoding='determining' stores the cubic scheme's 56 determining coefficients per cube (paper "
+                         "003 sec. 5.1); the quadratic scheme here takes its inner coefficients from the data, not from "
+                         "its 20 edge coefficients: use encoding='data' (1 value per cube) or 'coefficients'.")
     if roots is None:
         roots = "analytic"
     check_choice(roots, "roots", {"analytic", "bracketed", "paper"})
@@ -187,9 +195,11 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     ref = value_reference(spline)
     textures = {}
     if proxy == "blocks":
-        textures["sv_volume_mask"] = mask_texture(spline, rel, block_size)
+        textures["sv_volume_mask"] = mask_texture(spline, rel, block_size, encoding)
     if encoding == "data":
         textures["sv_volume_data"] = data_texture(spline)
+    elif encoding == "determining":
+        textures["sv_volume_det"] = determining_table(spline, rel)
     else:
         textures["sv_volume_coef"] = coefficient_table(spline, rel)[0]
     nz, ny, nx = spline.shape
@@ -212,6 +222,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         triangles=tris,
         offset=tuple(spline.origin),
         defines={"SV_VOLUME_CUBIC": cubic, "SV_VOLUME_TABLE": encoding == "coefficients",
+                 "SV_VOLUME_DETERMINING": encoding == "determining",
                  "SV_VOLUME_COLOR_FIELD": color_field is not None, "SV_VOLUME_BLOCKS": proxy == "blocks",
                  "SV_ROOTS_PAPER_NEWTON3": roots == "paper", "SV_ROOTS_BRACKETED": roots == "bracketed"},
         uniforms={
@@ -233,12 +244,30 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     )
 
 
-def _table_rows(rel: Relevant) -> np.ndarray:
+def _table_rows(rel: Relevant, encoding: str = "coefficients") -> np.ndarray:
+    """Row of each relevant cube's data in the per-isovalue table: its first tetrahedron's row (coefficient
+    table) or the cube's own index (determining-set table)."""
+    if encoding == "determining":
+        return np.arange(len(rel.cubes), dtype=np.int64)
     counts = np.bitwise_count(rel.masks).astype(np.int64)
     return np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
 
 
-def mask_texture(spline: VolumeSpline, rel: Relevant, block_size: int = BLOCK_SIZE) -> np.ndarray:
+def determining_table(spline: VolumeSpline, rel: Relevant) -> np.ndarray:
+    """(rows, TEXTURE_WIDTH, 4) float32: the 56 determining coefficients of every relevant cube (cubic scheme,
+    paper 003 sec. 5.1 / Fig. 4 masks), minus the reference value, one row of 56 floats per cube."""
+    from .cubic import determining_map
+
+    _, K = determining_map()
+    ref = value_reference(spline)
+    out = np.empty((len(rel.cubes), K.shape[0]), dtype=np.float64)
+    for s in range(0, len(rel.cubes), 32768):
+        out[s:s + 32768] = (spline.stencil_data(rel.cubes[s:s + 32768]) - ref) @ K.T
+    return _linear_texture(out)
+
+
+def mask_texture(spline: VolumeSpline, rel: Relevant, block_size: int = BLOCK_SIZE,
+                 encoding: str = "data") -> np.ndarray:
     """(rows, TEXTURE_WIDTH, 4) float32: for every block drawn (in :func:`proxy_units` order) one texel per
     cube of the block, ``block_id * B^3 + (a_z B + a_y) B + a_x``: the relevant-tetrahedron mask (exact:
     < 2^24), the cube's first coefficient-table row as two 12-bit halves, 0 = not relevant. Only blocks
@@ -254,7 +283,7 @@ def mask_texture(spline: VolumeSpline, rel: Relevant, block_size: int = BLOCK_SI
         block_id = np.searchsorted(bkey, key(rel.cubes // B))
         a = rel.cubes - (rel.cubes // B) * B
         k = block_id * B ** 3 + (a[:, 2] * B + a[:, 1]) * B + a[:, 0]
-        rows = _table_rows(rel)
+        rows = _table_rows(rel, encoding)
         info[k, 0] = rel.masks
         info[k, 1] = rows >> 12
         info[k, 2] = rows & 4095
@@ -295,8 +324,8 @@ def _proxies(spline: VolumeSpline, rel: Relevant, encoding: str, proxy: str = "c
     cube_attr = np.repeat(np.column_stack([rel.cubes, rel.masks & 4095]).astype(np.float64), 8, axis=0)
     extra = np.zeros((n, 3))
     extra[:, 0] = rel.masks >> 12
-    if encoding == "coefficients":
-        rows = _table_rows(rel)
+    if encoding in ("coefficients", "determining"):
+        rows = _table_rows(rel, encoding)
         extra[:, 1] = rows >> 12
         extra[:, 2] = rows & 4095
     attributes = {"sv_cube": cube_attr, "sv_cube_extra": np.repeat(extra, 8, axis=0)}
@@ -318,15 +347,19 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     if not np.isfinite(model.isovalue):
         raise ValueError(f"isovalue must be finite, got {isovalue!r}.")
     spline, rel = model.spline, model.relevant
-    encoding = "coefficients" if actor.spec.defines.get("SV_VOLUME_TABLE") else "data"
+    defines = actor.spec.defines
+    encoding = ("coefficients" if defines.get("SV_VOLUME_TABLE") else
+                "determining" if defines.get("SV_VOLUME_DETERMINING") else "data")
     blocks = bool(actor.spec.defines.get("SV_VOLUME_BLOCKS"))
     B = int(actor.spec.uniforms.get("sv_block_size", BLOCK_SIZE))
     points, tris, attributes, varyings = _proxies(spline, rel, encoding, "blocks" if blocks else "cubes", B)
     actor.set_geometry(points, tris, {**attributes, **varyings})
     if blocks:
-        actor.set_texture("sv_volume_mask", mask_texture(spline, rel, B))
+        actor.set_texture("sv_volume_mask", mask_texture(spline, rel, B, encoding))
     if encoding == "coefficients":
         actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
+    elif encoding == "determining":
+        actor.set_texture("sv_volume_det", determining_table(spline, rel))
     actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)
     culler = getattr(actor, "culler", None)
     if culler is not None:
