@@ -494,7 +494,7 @@ def pareto_figure(rows, setup, path):
         ax.set_ylabel(ylabel)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle(f"Accuracy vs time: {setup['field']}, {setup['grid']} samples (h = {setup['h']:.4f}); spline labels: "
+    fig.suptitle(f"Accuracy vs time: {setup['field']}, {setup['grid']} samples (h = {setup['h']:.4f});\nspline labels: "
                  "D/C/S = data texture / coefficient table / determining set, an = closed form, br = bracketed, pa = paper's Newton + iterations",
                  fontsize=9)
     fig.tight_layout()
