@@ -35,6 +35,22 @@ def _f(x: float) -> str:
     return r if ("." in r or "e" in r) else r + ".0"
 
 
+def _weighted_sum(w: np.ndarray, var: str) -> str:
+    """GLSL for sum_k w[k] var[k] with the terms grouped by weight (largest magnitude first); weights are
+    rounded to 15 decimals for grouping, so exact rationals from float64 solves group together."""
+    groups: dict = {}
+    value: dict = {}
+    for k in np.nonzero(np.abs(w) > 1e-14)[0]:
+        key = round(float(w[k]), 15)
+        groups.setdefault(key, []).append(int(k))
+        value.setdefault(key, float(w[k]))  # printed at full precision
+    parts = []
+    for key, ks in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
+        ssum = " + ".join(f"{var}[{k}]" for k in ks)
+        parts.append(f"{_f(value[key])} * ({ssum})" if len(ks) > 1 else f"{_f(value[key])} * {ssum}")
+    return " + ".join(parts)
+
+
 def type6() -> str:
     M = barycentric_matrices()  # (24, 4, 4): lam = M @ (x, y, z, 1)
     rows = ", ".join("vec4(" + ", ".join(_f(v) for v in M[t, i]) + ")" for t in range(24) for i in range(4))
@@ -154,14 +170,7 @@ def determining(scheme: str = "cubic") -> str:
            f"void sv_tet_coefficients_det(int t, float d[{nd}], out float b[{M.shape[1]}]) {{\n    float g[{nd}];\n"
            f"    for (int k = 0; k < {nd}; ++k) g[k] = d[SV_DET_PERM[{nd} * t + k]];\n"]
     for q in range(M.shape[1]):
-        groups: dict = {}
-        for k in np.nonzero(np.abs(M[0, q]) > 1e-14)[0]:
-            groups.setdefault(round(float(M[0, q, k]), 15), []).append(int(k))
-        parts = []
-        for val, ks in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
-            ssum = " + ".join(f"g[{k}]" for k in ks)
-            parts.append(f"{_f(val)} * ({ssum})" if len(ks) > 1 else f"{_f(val)} * {ssum}")
-        out.append(f"    b[{q}] = " + " + ".join(parts) + ";\n")
+        out.append(f"    b[{q}] = {_weighted_sum(M[0, q], 'g')};\n")
     out.append("}\n")
     return "".join(out)
 
@@ -207,15 +216,7 @@ def stencil(scheme: str) -> str:
            f"void sv_tet_coefficients(int t, float f[27], out float b[{m}]) {{\n    float g[27];\n"
            "    for (int s = 0; s < 27; ++s) g[s] = f[SV_STENCIL_PERM[27 * t + s]];\n"]
     for q in range(m):
-        w = W[0, q]
-        groups: dict = {}
-        for s in np.nonzero(np.abs(w) > 0)[0]:
-            groups.setdefault(float(w[s]), []).append(int(s))
-        parts = []
-        for val, ss in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
-            s_sum = " + ".join(f"g[{s}]" for s in ss)
-            parts.append(f"{_f(val)} * ({s_sum})" if len(ss) > 1 else f"{_f(val)} * {s_sum}")
-        out.append(f"    b[{q}] = " + " + ".join(parts) + ";\n")
+        out.append(f"    b[{q}] = {_weighted_sum(W[0, q], 'g')};\n")
     out.append("}\n")
     return "".join(out)
 

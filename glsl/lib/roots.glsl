@@ -62,18 +62,9 @@ void sv_inflection_points(float c[5], int n, out float w0, out float w1) {
     }
 }
 
-// Paper 000's method.  Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after
-// `iterations` (1..8) Newton steps from x = (0, w0, w1, 1).  Returns -1.0 when no candidate passes the residual test
-// |f(x)| <= K_n eps32 sum_k |c_k| B^n_k(x) (the Python twin returns NaN there).  A start whose
-// derivative is 0, or whose step is not finite, keeps its x.  Nothing is clamped: iterates leaving
-// [0, 1] are simply not accepted.  The zero polynomial returns 0.
-float sv_first_root_newton4(float c[5], int n, int iterations) {
-    float w0;
-    float w1;
-    sv_inflection_points(c, n, w0, w1);
-    if (!(w0 > 0.0 && w0 < 1.0)) w0 = 1.0 / 3.0;
-    if (!(w1 > 0.0 && w1 < 1.0)) w1 = 2.0 / 3.0;
-    vec4 x = vec4(0.0, w0, w1, 1.0);
+// Newton from the four starts x with `iterations` (1..8) steps and the residual acceptance of paper 000:
+// the smallest accepted x in [0, 1], -1.0 if none (shared by the paper's 4-start and 3-start variants).
+float sv_newton_from_starts(float c[5], int n, vec4 x, int iterations) {
     vec4 f;
     vec4 fp;
     for (int it = 0; it < 8; ++it) {
@@ -99,6 +90,20 @@ float sv_first_root_newton4(float c[5], int n, int iterations) {
         if (x[i] >= 0.0 && x[i] <= 1.0 && abs(f[i]) <= tol[i]) best = min(best, x[i]);
     }
     return (best <= 1.0) ? best : -1.0;
+}
+
+// Paper 000's method.  Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after
+// `iterations` (1..8) Newton steps from x = (0, w0, w1, 1).  Returns -1.0 when no candidate passes the residual test
+// |f(x)| <= K_n eps32 sum_k |c_k| B^n_k(x) (the Python twin returns NaN there).  A start whose
+// derivative is 0, or whose step is not finite, keeps its x.  Nothing is clamped: iterates leaving
+// [0, 1] are simply not accepted.  The zero polynomial returns 0.
+float sv_first_root_newton4(float c[5], int n, int iterations) {
+    float w0;
+    float w1;
+    sv_inflection_points(c, n, w0, w1);
+    if (!(w0 > 0.0 && w0 < 1.0)) w0 = 1.0 / 3.0;
+    if (!(w1 > 0.0 && w1 < 1.0)) w1 = 2.0 / 3.0;
+    return sv_newton_from_starts(c, n, vec4(0.0, w0, w1, 1.0), iterations);
 }
 
 // ------------------------------------------------------------------------------------------------------
@@ -464,29 +469,6 @@ float sv_first_root_newton3(float c[5], int iterations) {
     float w1;
     sv_inflection_points(c, 3, w0, w1);
     if (!(w0 > 0.0 && w0 < 1.0)) w0 = 0.5;
-    vec4 x = vec4(0.0, w0, 1.0, w0);
-    vec4 f;
-    vec4 fp;
-    for (int it = 0; it < 8; ++it) {
-        if (it < iterations) {
-            sv_bernstein_eval_deriv4(c, 3, x, f, fp);
-            bvec4 nz = notEqual(fp, vec4(0.0));
-            vec4 xn = x - f / mix(vec4(1.0), fp, nz);
-            bvec4 ok = bvec4(nz.x && abs(xn.x) < 1e30, nz.y && abs(xn.y) < 1e30,
-                             nz.z && abs(xn.z) < 1e30, nz.w && abs(xn.w) < 1e30);
-            x = mix(x, xn, ok);
-        }
-    }
-    float ca[5];
-    for (int k = 0; k < 5; ++k) ca[k] = abs(c[k]);
-    vec4 S;
-    vec4 dummy;
-    sv_bernstein_eval_deriv4(c, 3, x, f, fp);
-    sv_bernstein_eval_deriv4(ca, 3, x, S, dummy);
-    vec4 tol = sv_root_tol_k(3) * SV_ROOT_EPS32 * S;
-    float best = 2.0;
-    for (int i = 0; i < 4; ++i) {
-        if (x[i] >= 0.0 && x[i] <= 1.0 && abs(f[i]) <= tol[i]) best = min(best, x[i]);
-    }
-    return (best <= 1.0) ? best : -1.0;
+    // the fourth lane repeats the middle start (vec4 arithmetic; it changes nothing)
+    return sv_newton_from_starts(c, 3, vec4(0.0, w0, 1.0, w0), iterations);
 }

@@ -177,6 +177,24 @@ def inflection_points(c, *, dtype=np.float64):
         return _inflection_points(c.astype(dtype), dtype)
 
 
+def _newton_from_starts(cc, n, x, iterations, dtype):
+    """Twin of ``sv_newton_from_starts``: ``iterations`` Newton steps from the starts x (..., 4), then the
+    smallest x in [0, 1] passing ``|f(x)| <= K_n eps32 sum_k |c_k| B_k(x)``; (root or NaN, x, accepted)."""
+    c4 = cc[..., None, :]  # broadcast the coefficients over the four starts
+    for _ in range(iterations):
+        f, fp = _eval_deriv(c4, x, dtype)
+        nz = fp != 0.0                                       # bvec4 nz = notEqual(fp, vec4(0.0));
+        xn = x - f / np.where(nz, fp, dtype(1.0))            # vec4 xn = x - f / mix(vec4(1.0), fp, nz);
+        ok = nz & (np.abs(xn) < 1e30)                        # keep x where f' = 0 or step not finite
+        x = np.where(ok, xn, x).astype(dtype)                # x = mix(x, xn, ok);
+    f, _ = _eval_deriv(c4, x, dtype)
+    S, _ = _eval_deriv(np.abs(c4), x, dtype)                 # S = sum |c_k| B_k(x)
+    tol = dtype(root_tolerance_k(n)) * dtype(EPS32) * S      # vec4 tol = sv_root_tol_k(n) * SV_ROOT_EPS32 * S;
+    accept = (x >= 0.0) & (x <= 1.0) & (np.abs(f) <= tol)
+    best = np.min(np.where(accept, x, np.inf), axis=-1)
+    return np.where(np.isfinite(best), best, np.nan), x, accept
+
+
 def newton_secure(c, iterations: int = 6, *, dtype=np.float64, return_candidates: bool = False):
     """First root in [0, 1] by Newton iteration from secure starting points (the GPU method).
 
@@ -220,19 +238,7 @@ def newton_secure(c, iterations: int = 6, *, dtype=np.float64, return_candidates
         w1 = np.where((w1 > 0.0) & (w1 < 1.0), w1, dtype(np.float32(2.0 / 3.0)))
         # vec4 x = vec4(0.0, w0, w1, 1.0);
         x = np.stack([np.zeros_like(w0), w0, w1, np.ones_like(w0)], axis=-1).astype(dtype)
-        c4 = cc[..., None, :]  # broadcast the coefficients over the four starts
-        for _ in range(iterations):
-            f, fp = _eval_deriv(c4, x, dtype)
-            nz = fp != 0.0                                       # bvec4 nz = notEqual(fp, vec4(0.0));
-            xn = x - f / np.where(nz, fp, dtype(1.0))            # vec4 xn = x - f / mix(vec4(1.0), fp, nz);
-            ok = nz & (np.abs(xn) < 1e30)                        # keep x where f' = 0 or step not finite
-            x = np.where(ok, xn, x).astype(dtype)                # x = mix(x, xn, ok);
-        f, _ = _eval_deriv(c4, x, dtype)
-        S, _ = _eval_deriv(np.abs(c4), x, dtype)                 # S = sum |c_k| B_k(x)
-        tol = dtype(root_tolerance_k(n)) * dtype(EPS32) * S      # vec4 tol = sv_root_tol_k(n) * SV_ROOT_EPS32 * S;
-        accept = (x >= 0.0) & (x <= 1.0) & (np.abs(f) <= tol)
-        best = np.min(np.where(accept, x, np.inf), axis=-1)
-        root = np.where(np.isfinite(best), best, np.nan)
+        root, x, accept = _newton_from_starts(cc, n, x, iterations, dtype)
     if return_candidates:
         return root, x, accept
     return root
@@ -803,15 +809,5 @@ def newton_three_starts(c, iterations: int = 5, *, dtype=np.float64):
         w0, _ = _inflection_points(cc, dt)
         w0 = np.where((w0 > 0.0) & (w0 < 1.0), w0, dt(0.5))          # if (!(w0 > 0 && w0 < 1)) w0 = 0.5;
         x = np.stack([np.zeros_like(w0), w0, np.ones_like(w0), w0], axis=-1).astype(dt)
-        c4 = cc[..., None, :]
-        for _ in range(iterations):
-            f, fp = _eval_deriv(c4, x, dt)
-            nz = fp != 0.0
-            xn = x - f / np.where(nz, fp, dt(1.0))
-            x = np.where(nz & (np.abs(xn) < 1e30), xn, x).astype(dt)
-        f, _ = _eval_deriv(c4, x, dt)
-        S, _ = _eval_deriv(np.abs(c4), x, dt)
-        tol = dt(root_tolerance_k(3)) * dt(EPS32) * S
-        accept = (x >= 0.0) & (x <= 1.0) & (np.abs(f) <= tol)
-        best = np.min(np.where(accept, x, np.inf), axis=-1)
-    return np.where(np.isfinite(best), best, np.nan)
+        root, _, _ = _newton_from_starts(cc, 3, x, iterations, dt)
+    return root
