@@ -36,26 +36,7 @@ def tet_weights(scheme: str) -> np.ndarray:
     ``(i, j, k)`` is ``sum_s W[t, q, s] * padded_data[(i, j, k) + STENCIL[s]]`` (m = 10 quadratic, 20 cubic)."""
     if scheme not in SCHEME_DEGREE:
         raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
-    if hasattr(_schemes, "tet_weights"):
-        return np.asarray(_schemes.tet_weights(scheme), dtype=np.float64)
-    if scheme != "quadratic":
-        raise NotImplementedError("cubic weights pending")
-    _, tmap = _schemes.domain_points()  # TEMPORARY until schemes.tet_weights lands
-    return _schemes.derive_weights()["W"][tmap]
-
-
-def pad_linear(values: np.ndarray) -> np.ndarray:
-    """One layer of linear extrapolation around a (nz, ny, nx) volume, ``f[-1] = 2 f[0] - f[1]`` axis by axis
-    (corners too), in one allocation; keeps linear data linear (docs/volume-schemes.md, "Boundary")."""
-    v = np.asarray(values, dtype=np.float64)
-    nz, ny, nx = v.shape
-    P = np.zeros((nz + 2, ny + 2, nx + 2))  # borders are all overwritten; zeros keep garbage out of the arithmetic
-    P[1:-1, 1:-1, 1:-1] = v
-    for ax in range(3):
-        Q = np.moveaxis(P, ax, 0)  # a view
-        np.subtract(2 * Q[1], Q[2], out=Q[0])
-        np.subtract(2 * Q[-2], Q[-3], out=Q[-1])
-    return P
+    return _schemes.tet_weights(scheme)
 
 
 def _negative_mass(W: np.ndarray) -> float:
@@ -132,7 +113,7 @@ class VolumeSpline:
         self.weights = tet_weights(scheme)
         self.ncoef = self.weights.shape[1]
         t0 = time.perf_counter()
-        self.padded = pad_linear(grid.values)
+        self.padded = _schemes._pad(grid.values)  # the grid is validated already
         self._octree = None
         self.setup_seconds = time.perf_counter() - t0
 

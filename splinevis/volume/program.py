@@ -104,13 +104,10 @@ def data_texture(spline: VolumeSpline) -> np.ndarray:
     return _linear_texture(spline.padded, value_reference(spline))
 
 
-def coefficient_table(spline: VolumeSpline, relevant: Relevant):
-    """(texture, rows): coefficients of every relevant tetrahedron (minus the reference value), in cube order
-    then tetrahedron order; ``rows[n]`` is the table row of cube n's first relevant tetrahedron."""
-    m = spline.ncoef
-    counts = np.bitwise_count(relevant.masks).astype(np.int64)
-    rows = np.concatenate([[0], np.cumsum(counts)[:-1]]) if len(counts) else np.zeros(0, np.int64)
-    out = np.empty((int(counts.sum()), m), dtype=np.float64)
+def coefficient_table(spline: VolumeSpline, relevant: Relevant) -> np.ndarray:
+    """Texture of the coefficients of every relevant tetrahedron (minus the reference value), in cube order
+    then tetrahedron order; cube n's first row is ``_table_rows(relevant)[n]``."""
+    out = np.empty((relevant.num_tets, spline.ncoef), dtype=np.float64)
     ref = value_reference(spline)
     chunk, pos = 16384, 0
     for s in range(0, len(relevant.cubes), chunk):
@@ -119,7 +116,7 @@ def coefficient_table(spline: VolumeSpline, relevant: Relevant):
         sel = coef[bits]  # row-major: cube order, then tetrahedron order
         out[pos:pos + len(sel)] = sel - ref
         pos += len(sel)
-    return _linear_texture(out), rows
+    return _linear_texture(out)
 
 
 def memory_report(spline: VolumeSpline, relevant: Relevant, block_size: int = BLOCK_SIZE) -> dict:
@@ -201,7 +198,7 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
     elif encoding == "determining":
         textures["sv_volume_det"] = determining_table(spline, rel)
     else:
-        textures["sv_volume_coef"] = coefficient_table(spline, rel)[0]
+        textures["sv_volume_coef"] = coefficient_table(spline, rel)
     nz, ny, nx = spline.shape
     scalar_range = spline.value_range
     if color_field is not None:
@@ -211,9 +208,9 @@ def isosurface_program(model: Isosurface, *, newton_iterations: int = 6, encodin
         if not np.isfinite(values).all():
             k, j, i = (int(v) for v in np.argwhere(~np.isfinite(values))[0])
             raise ValueError(f"color_field has a non-finite value at voxel [k, j, i] = [{k}, {j}, {i}].")
-        from .model import pad_linear
+        from .schemes import _pad
 
-        textures["sv_color_data"] = _linear_texture(pad_linear(values))
+        textures["sv_color_data"] = _linear_texture(_pad(values))
         scalar_range = (float(values.min()), float(values.max()))
     return ProgramSpec(
         name="isosurface",
@@ -357,7 +354,7 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     if blocks:
         actor.set_texture("sv_volume_mask", mask_texture(spline, rel, B, encoding))
     if encoding == "coefficients":
-        actor.set_texture("sv_volume_coef", coefficient_table(spline, rel)[0])
+        actor.set_texture("sv_volume_coef", coefficient_table(spline, rel))
     elif encoding == "determining":
         actor.set_texture("sv_volume_det", determining_table(spline, rel))
     actor.extra_uniforms["sv_iso_shifted"] = model.isovalue - value_reference(spline)

@@ -339,13 +339,16 @@ def _check_volume(volume, what="the 27-point stencil of the spline schemes"):
 
 
 def _pad(vol):
-    p = np.pad(vol, 1, mode="edge")
+    """Linear extrapolation by one layer, axis after axis (corners too), in one float64 allocation."""
+    v = np.asarray(vol, dtype=np.float64)
+    nz, ny, nx = v.shape
+    P = np.zeros((nz + 2, ny + 2, nx + 2))  # borders are all overwritten; zeros keep garbage out of the arithmetic
+    P[1:-1, 1:-1, 1:-1] = v
     for ax in range(3):
-        p = np.moveaxis(p, ax, 0)
-        p[0] = 2 * p[1] - p[2]
-        p[-1] = 2 * p[-2] - p[-3]
-        p = np.moveaxis(p, 0, ax)
-    return p
+        Q = np.moveaxis(P, ax, 0)  # a view
+        np.subtract(2 * Q[1], Q[2], out=Q[0])
+        np.subtract(2 * Q[-2], Q[-3], out=Q[-1])
+    return P
 
 
 def pad_volume(volume) -> np.ndarray:
