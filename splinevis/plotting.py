@@ -20,37 +20,7 @@ import pyvista as pv  # noqa: E402  (after configure: VTK reads the window class
 
 from .gl.inject import SplineActor, capture_vtk_errors, raise_for_shader_errors  # noqa: E402
 
-__all__ = ["Plotter", "register_program"]
-
-#: model type -> function(model, **options) -> ProgramSpec. Spline packages register themselves.
-_PROGRAMS: dict = {}
-
-
-def register_program(model_type, builder) -> None:
-    """Make :meth:`Plotter.add_spline` accept models of ``model_type`` using ``builder``."""
-    _PROGRAMS[model_type] = builder
-
-
-def _register_builtin_programs():
-    from .analytic import QuarticTrianglePatch
-    from .analytic.program import patch_program
-    from .terrain.model import TerrainSpline
-    from .terrain.program import terrain_program
-
-    from .volume.program import Isosurface, isosurface_program
-
-    _PROGRAMS.setdefault(QuarticTrianglePatch, patch_program)
-    _PROGRAMS.setdefault(TerrainSpline, terrain_program)
-    _PROGRAMS.setdefault(Isosurface, isosurface_program)
-
-
-def _builder_for(model):
-    _register_builtin_programs()
-    for cls in type(model).__mro__:
-        if cls in _PROGRAMS:
-            return _PROGRAMS[cls]
-    known = ", ".join(sorted(c.__name__ for c in _PROGRAMS))
-    raise TypeError(f"add_spline cannot draw a {type(model).__name__}; it draws: {known}.")
+__all__ = ["Plotter"]
 
 
 def _style_from(style, style_kwargs) -> Style:
@@ -99,24 +69,27 @@ class Plotter(pv.Plotter):
         self._spline_actors: list[SplineActor] = []
         self._gl_checked = False
 
-    def add_spline(self, model, style: Style | None = None, *, name: str | None = None, newton_iterations: int = 8,
-                   program_options: dict | None = None, **style_options) -> SplineActor:
-        """Add a spline model, ray-cast per pixel, beside any ordinary meshes.
+    def add_spline(self, model, style: Style | None = None, *, name: str | None = None,
+                   newton_iterations: int | None = None, program_options: dict | None = None,
+                   **style_options) -> SplineActor:
+        """Add a spline model, drawn exactly per pixel by its program, beside any ordinary meshes.
+
+        The model's program is found in the registry (:func:`splinevis.programs.program_for`).
 
         Parameters
         ----------
         model
-            A spline model (e.g. :class:`splinevis.analytic.QuarticTrianglePatch`).
+            A spline model of any registered family (e.g. :class:`splinevis.analytic.QuarticTrianglePatch`).
         style : Style, optional
             Effects and their parameters; keyword options (``lights=2``, ``reflection_lines=12``, …)
             build or amend it. Only the declared effects are compiled in.
         name : str, optional
             Actor name (as in :meth:`pyvista.Plotter.add_actor`).
-        newton_iterations : int, default 8
-            Fixed iteration count of the root finder, 1..8 (safeguarded Newton steps per piece).
+        newton_iterations : int, optional
+            Fixed iteration count of the root finder, 1..8 (default: the program's own).
         program_options : dict, optional
-            Options of the model's program builder (e.g. ``{"coefficients_in": "texture"}`` for the
-            analytic patch).
+            Options of the model's program (``splinevis.programs.program_for(model).options``, e.g.
+            ``{"coefficients_in": "texture"}`` for the analytic patch).
 
         Returns
         -------
@@ -124,10 +97,18 @@ class Plotter(pv.Plotter):
             Holds the VTK actor (``.actor``), the assembled GLSL (``.assembled``) and, after the first
             render, the compiled sources (``.program_sources``).
         """
+        from .programs import program_for
+
         st = _style_from(style, style_options)
-        spec = _builder_for(model)(model, newton_iterations=newton_iterations, **(program_options or {}))
-        spline = SplineActor(spec, st, self.renderer)
+        program = program_for(model)
+        built = program.make(model, st, newton_iterations=newton_iterations, **(program_options or {}))
+        if program.kind in ("passes", "mesh"):  # the program made an ordinary dataset: a mesh with the effects
+            from .gl.mesh_effects import add_mesh_with_effects
+
+            return add_mesh_with_effects(self, built, st, name=name)
+        spline = SplineActor(built, st, self.renderer)
         spline.model = model
+        spline.program = program
         self.add_actor(spline.actor, name=name, reset_camera=True)
         self._spline_actors.append(spline)
         return spline
@@ -151,15 +132,12 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
-        from .terrain.model import TerrainSpline
-
-        model = TerrainSpline.from_heights(heights, scheme, **(read_options or {}))
-        return self.add_spline(model, style, **options)
+        return self._add_from("terrain", (heights, scheme), read_options, style, options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
                        **options):
-        """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data (paper 003).
+        """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data [Kalbe2008].
 
         ``volume`` is a :class:`~splinevis.volume.VolumeSpline`, a :class:`~splinevis.io.VolumeGrid`, or
         anything :func:`splinevis.io.read_volume` reads (3-D array, pyvista ImageData, .vti/.nrrd/.mha/...
@@ -167,7 +145,7 @@ class Plotter(pv.Plotter):
         view-frustum culling of the proxies by the octree before every frame (``actor.culler``). Program options
         (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
         :meth:`add_spline`). An isovalue outside the data's range draws nothing. Returns the
-        :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.program.Isosurface`.
+        :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.isosurface.Isosurface`.
 
         Examples
         --------
@@ -179,16 +157,17 @@ class Plotter(pv.Plotter):
         >>> len(actor.model.relevant.cubes) > 0
         True
         """
-        from .volume.model import VolumeSpline
-        from .volume.program import Isosurface
+        return self._add_from("isosurface", (volume, isovalue, scheme), read_options, style,
+                              dict(options, newton_iterations=newton_iterations), {"culling": culling})
 
-        from .volume.culling import FrustumCuller
+    def _add_from(self, program_name, args, read_options, style, options, add_options=None):
+        """Build a model of the registered program ``program_name`` from user data, add it, run its hook."""
+        from .programs import get
 
-        spline = volume if isinstance(volume, VolumeSpline) else VolumeSpline(volume, scheme, **(read_options or {}))
-        actor = self.add_spline(Isosurface(spline, isovalue), style, newton_iterations=newton_iterations, **options)
-        if culling:
-            actor.culler = FrustumCuller(actor)
-            actor.culler.attach(self.renderer)
+        program = get(program_name)
+        actor = self.add_spline(program.model_from(*args, **(read_options or {})), style, **options)
+        if program.on_add is not None:
+            program.on_add(actor, self, **(add_options or {}))
         return actor
 
     def render(self) -> None:

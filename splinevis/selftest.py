@@ -22,7 +22,7 @@ import numpy as np
 from .bb import roots as _roots
 from .bb import simplex as _simplex
 
-__all__ = ["run_selftest", "gamma_eps", "EVAL_BOUND", "DERIV_BOUND", "RESTRICT_BOUND", "ROOT_BOUND",
+__all__ = ["run_selftest", "program_hard_cases", "gamma_eps", "EVAL_BOUND", "DERIV_BOUND", "RESTRICT_BOUND", "ROOT_BOUND",
            "classify_first_roots"]
 
 U32 = 2.0**-24
@@ -295,7 +295,7 @@ def _test_eval_deriv(rng, m, n, results):
             f"sv_bernstein_eval_deriv(c, {n}, sv_in[{n + 1}], f, fp);\n"
             f"sv_out[0] = sv_bernstein_eval(c, {n}, sv_in[{n + 1}]); sv_out[1] = sv_bernstein_deriv(c, {n}, sv_in[{n + 1}]);\n"
             "sv_out[2] = f; sv_out[3] = fp;")
-    out = run_glsl('#include "lib/bernstein.glsl"\n', body, inputs, 4)
+    out = run_glsl('#include "lib/core/bernstein.glsl"\n', body, inputs, 4)
     c = c32.astype(np.float64)
     t = t32.astype(np.float64)
     f64 = _simplex._decasteljau(c, n, 1, np.stack([1.0 - t, t], axis=-1))
@@ -321,7 +321,7 @@ def _test_restrict(rng, m, results):
             "vec3 l0 = vec3(sv_in[15], sv_in[16], sv_in[17]); vec3 l1 = vec3(sv_in[18], sv_in[19], sv_in[20]);\n"
             "float c[5]; sv_restrict_quartic_tri(b, l0, l1, c);\n"
             "for (int k = 0; k < 5; ++k) sv_out[k] = c[k];")
-    out = run_glsl('#include "lib/blossom.glsl"\n', body, inputs, 5)
+    out = run_glsl('#include "lib/simplex/blossom.glsl"\n', body, inputs, 5)
     b = b32.astype(np.float64)
     l0 = l032.astype(np.float64)
     l1 = l132.astype(np.float64)
@@ -340,7 +340,7 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
     else:                        # bracketed Newton on convex pieces: the bracket is <= 4^-N wide
         glsl_name, twin, absolute_bound = "sv_first_root_bracketed", _roots.first_root_bracketed, 4.0**-iterations
     body = f"sv_out[0] = {glsl_name}({_c5(n=n)}, {n}, {iterations});"
-    g = run_glsl('#include "lib/roots.glsl"\n', body, c32, 1)[:, 0].astype(np.float64)
+    g = run_glsl('#include "lib/core/roots.glsl"\n', body, c32, 1)[:, 0].astype(np.float64)
     g = np.where(g == -1.0, np.nan, g)
     c = c32.astype(np.float64)
     tw = twin(c, iterations)                                      # float64 twin
@@ -464,9 +464,34 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
     results[f"first_root_n{n}" if method == "newton4" else f"first_root_bracketed_n{n}"] = res
 
 
+def program_hard_cases(progress: bool = True) -> dict:
+    """Every registered ray-cast program (:mod:`splinevis.programs`) on the hard cases it declares, GPU against
+    its float64 twin per pixel (:func:`splinevis.analysis.agreement.hard_case_agreement`).
+
+    Returns ``{program: {case: {pixels, both, leaks, hit_disagree, within_bound, failures, pass}}}``.
+    """
+    from tqdm.auto import tqdm
+
+    from .analysis.agreement import agreement_failures, hard_case_agreement
+    from .programs import all_programs
+
+    cases = [(p.name, c) for p in all_programs() if p.kind == "raycast" and p.hard_cases is not None
+             for c in p.hard_cases()]
+    out: dict = {}
+    for name, case in tqdm(cases, disable=not progress, desc="hard cases", unit="case"):
+        r = hard_case_agreement(case)
+        failures = agreement_failures(r, case)
+        within = float((r["depth_error"] <= r["depth_bound"]).mean()) if r["both"] else None
+        out.setdefault(name, {})[case.name] = {
+            "pixels": r["pixels"], "both": r["both"], "leaks": r["leaks"], "hit_disagree": r["hit_disagree"],
+            "within_bound": within, "failures": failures, "pass": not failures}
+    return out
+
+
 def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool = True,
-                 iterations: int = 6) -> dict:
-    """Compare the GLSL library with its float64 twins on ``cases`` random inputs per function.
+                 iterations: int = 6, programs: bool = True) -> dict:
+    """Compare the GLSL library with its float64 twins on ``cases`` random inputs per function, and (with
+    ``programs``) every registered ray-cast program with its twin on its hard cases (:func:`program_hard_cases`).
 
     Parameters
     ----------
@@ -484,6 +509,8 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
         :func:`~splinevis.bb.roots.newton_secure`, ``first_root_bracketed_n*`` rows the default
         ``sv_first_root_bracketed`` against :func:`~splinevis.bb.roots.first_root_bracketed`. Both rows
         carry ``vs_reference``: miss / wrong-root counts on well-conditioned first roots.
+    programs : bool
+        Also render every program's hard cases (about a minute on llvmpipe).
 
     Returns
     -------
@@ -511,9 +538,11 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
         job()
     from .gl.harness import get_context
 
+    hard = program_hard_cases(progress) if programs else {}
     summary = {
         "functions": results,
-        "pass": all(r["pass"] for r in results.values()),
+        "programs": hard,
+        "pass": all(r["pass"] for r in results.values()) and all(c["pass"] for p in hard.values() for c in p.values()),
         "cases_per_function": int(cases),
         "seed": int(seed),
         "seconds": time.perf_counter() - t0,

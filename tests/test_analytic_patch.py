@@ -42,7 +42,7 @@ def test_ray_outside_triangle_misses_and_gpu_twin_agrees_with_reference():
     o = np.c_[xy, np.full(500, 3.0)]
     d = np.c_[rng.uniform(-0.2, 0.2, (500, 2)), -np.ones(500)]
     a = p.raycast(o, d, method="reference")
-    b = p.raycast(o, d, method="gpu", iterations=8)
+    b = p.raycast(o, d, method="bracketed", iterations=8)
     assert a.hit.mean() > 0.5  # most rays of this bundle cross the patch (some leave the triangle)
     assert np.array_equal(a.hit, b.hit)
     # 8 safeguarded Newton steps from the Fourier end point converge quadratically on these simple
@@ -82,7 +82,7 @@ def test_bad_raycast_method_and_iterations():
     with pytest.raises(ValueError, match="method 'bisect' is not known"):
         p.raycast([0, 0, 1], [0, 0, -1], method="bisect")
     with pytest.raises(ValueError, match="iterations"):
-        p.raycast([0, 0, 1], [0, 0, -1], method="gpu", iterations=0)
+        p.raycast([0, 0, 1], [0, 0, -1], method="bracketed", iterations=0)
 
 
 def test_patch_coefficient_order_matches_multi_indices():

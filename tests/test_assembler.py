@@ -48,9 +48,9 @@ def test_flags_false_is_absent_true_is_one():
 
 
 def test_cache_returns_same_object_for_same_key():
-    a = assemble('#include "lib/raycast.glsl"\n', {"SV_A": 1})
-    b = assemble('#include "lib/raycast.glsl"\n', {"SV_A": 1})
-    c = assemble('#include "lib/raycast.glsl"\n', {"SV_A": 2})
+    a = assemble('#include "lib/core/raycast.glsl"\n', {"SV_A": 1})
+    b = assemble('#include "lib/core/raycast.glsl"\n', {"SV_A": 1})
+    c = assemble('#include "lib/core/raycast.glsl"\n', {"SV_A": 2})
     assert a is b and a is not c
 
 
@@ -79,7 +79,7 @@ def test_bad_flag_value_type_is_rejected():
 
 def test_shipped_glsl_root_has_the_library():
     root = glsl_root()
-    for f in ["lib/raycast.glsl", "lib/shading.glsl", "lib/bernstein.glsl", "lib/roots.glsl", "lib/blossom.glsl",
+    for f in ["lib/core/raycast.glsl", "lib/core/shading.glsl", "lib/core/bernstein.glsl", "lib/core/roots.glsl", "lib/simplex/blossom.glsl",
               "programs/analytic_patch.glsl"]:
         assert (root / f).is_file(), f
 
@@ -127,5 +127,5 @@ def test_generated_blossom_steps_are_current():
     spec = importlib.util.spec_from_file_location("gen_blossom_glsl", root / "tools" / "gen_blossom_glsl.py")
     gen = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(gen)
-    assert (glsl_root() / "lib" / "blossom_steps.glsl").read_text() == gen.generate(), \
+    assert (glsl_root() / "lib" / "simplex" / "blossom_steps.glsl").read_text() == gen.generate(), \
         "run: python tools/gen_blossom_glsl.py"

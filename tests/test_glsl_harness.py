@@ -24,7 +24,7 @@ def test_bernstein_exact_values_at_half():
     rows = np.array([[1, 0, 0, 0, 0, 0.5], [0, 0, 0, 0, 1, 0.5], [1, 2, 3, 4, 5, 1.0], [1, 2, 3, 4, 5, 0.0]], np.float32)
     body = ("float c[5] = float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]);"
             "sv_out[0] = sv_bernstein_eval(c, 4, sv_in[5]); sv_out[1] = sv_bernstein_deriv(c, 4, sv_in[5]);")
-    out = run_glsl('#include "lib/bernstein.glsl"\n', body, rows, 2)
+    out = run_glsl('#include "lib/core/bernstein.glsl"\n', body, rows, 2)
     assert out[:, 0].tolist() == [1 / 16, 1 / 16, 5.0, 1.0]
     assert out[:, 1].tolist() == [-0.5, 0.5, 4.0, 4.0]
 
@@ -33,7 +33,7 @@ def test_first_root_matches_float32_emulation_and_twin():
     rng = np.random.default_rng(1)
     c = (rng.normal(size=(20000, 5)) * 10.0 ** rng.uniform(-3, 3, size=(20000, 1))).astype(np.float32)
     body = "sv_out[0] = sv_first_root_newton4(float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]), 4, 6);"
-    g = run_glsl('#include "lib/roots.glsl"\n', body, c, 1)[:, 0]
+    g = run_glsl('#include "lib/core/roots.glsl"\n', body, c, 1)[:, 0]
     g = np.where(g == -1.0, np.nan, g)
     em = newton_secure(c, 6, dtype=np.float32)
     # same operations in IEEE float32: llvmpipe reproduces the emulation except for rare FMA/trajectory cases
@@ -69,7 +69,7 @@ def test_first_root_bracketed_equals_float32_twin_on_hard_cases(n, iterations):
     c = _hard_root_cases(np.random.default_rng(10 + n), 20_000, n)
     args = ", ".join(f"sv_in[{k}]" if k <= n else "0.0" for k in range(5))
     for name in ("sv_first_root_bracketed", "sv_first_root"):   # sv_first_root dispatches to it by default
-        g = run_glsl('#include "lib/roots.glsl"\n', f"sv_out[0] = {name}(float[5]({args}), {n}, {iterations});", c, 1)[:, 0]
+        g = run_glsl('#include "lib/core/roots.glsl"\n', f"sv_out[0] = {name}(float[5]({args}), {n}, {iterations});", c, 1)[:, 0]
         g = np.where(g == -1.0, np.nan, g)
         em = first_root_bracketed(c, iterations, dtype=np.float32)
         # llvmpipe is bit-identical to the float32 twin (same operations in the same order, no FMA contraction)
@@ -79,8 +79,8 @@ def test_first_root_bracketed_equals_float32_twin_on_hard_cases(n, iterations):
 def test_sv_first_root_paper_flag_selects_newton4():
     c = np.random.default_rng(5).normal(size=(5000, 5)).astype(np.float32)
     body = "sv_out[0] = sv_first_root(float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]), 4, 6);"
-    g = run_glsl('#include "lib/roots.glsl"\n', body, c, 1, defines={"SV_ROOTS_PAPER_NEWTON": True})[:, 0]
-    ref = run_glsl('#include "lib/roots.glsl"\n', body.replace("sv_first_root(", "sv_first_root_newton4("), c, 1)[:, 0]
+    g = run_glsl('#include "lib/core/roots.glsl"\n', body, c, 1, defines={"SV_ROOTS_PAPER": True})[:, 0]
+    ref = run_glsl('#include "lib/core/roots.glsl"\n', body.replace("sv_first_root(", "sv_first_root_newton4("), c, 1)[:, 0]
     assert np.array_equal(g, ref)
 
 
@@ -93,7 +93,7 @@ def test_restrict_quartic_tri_matches_twin():
     body = ("float b[15]; for (int q = 0; q < 15; ++q) b[q] = sv_in[q];"
             "float c[5]; sv_restrict_quartic_tri(b, vec3(sv_in[15], sv_in[16], sv_in[17]), vec3(sv_in[18], sv_in[19], sv_in[20]), c);"
             "for (int k = 0; k < 5; ++k) sv_out[k] = c[k];")
-    out = run_glsl('#include "lib/blossom.glsl"\n', body, np.concatenate([b, l0, l1], 1), 5)
+    out = run_glsl('#include "lib/simplex/blossom.glsl"\n', body, np.concatenate([b, l0, l1], 1), 5)
     ref = restrict_to_segment(b.astype(float), l0.astype(float), l1.astype(float), d=2)
     scale = restrict_to_segment(np.abs(b.astype(float)), l0.astype(float), l1.astype(float), d=2)
     # derived bound gamma_12 (4 levels x 3 roundings) in units of the |b| blossom
@@ -103,7 +103,7 @@ def test_restrict_quartic_tri_matches_twin():
 
 
 def test_compiles_under_version_150_in_one_program():
-    src = '#include "lib/roots.glsl"\n#include "lib/blossom.glsl"\n#include "lib/bernstein.glsl"\n'
+    src = '#include "lib/core/roots.glsl"\n#include "lib/simplex/blossom.glsl"\n#include "lib/core/bernstein.glsl"\n'
     out = run_glsl(src, "sv_out[0] = sv_bernstein_eval(float[5](1.0, 1.0, 1.0, 1.0, 1.0), 4, sv_in[0]);",
                    np.array([[0.3]], np.float32), 1)
     assert out[0, 0] == pytest.approx(1.0, abs=4 * EPS32)
@@ -135,9 +135,9 @@ def test_large_batch_is_fast():
 
     x = np.random.default_rng(3).random((100_000, 6)).astype(np.float32)
     body = "float c[5] = float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], sv_in[4]); sv_out[0] = sv_bernstein_eval(c, 4, sv_in[5]);"
-    run_glsl('#include "lib/bernstein.glsl"\n', body, x[:10], 1)  # compile once
+    run_glsl('#include "lib/core/bernstein.glsl"\n', body, x[:10], 1)  # compile once
     t0 = time.perf_counter()
-    out = run_glsl('#include "lib/bernstein.glsl"\n', body, x, 1)
+    out = run_glsl('#include "lib/core/bernstein.glsl"\n', body, x, 1)
     assert time.perf_counter() - t0 < 2.0
     ref = de_casteljau(x[:, :5].astype(float), np.stack([1 - x[:, 5].astype(float), x[:, 5]], -1), d=1)
     S = de_casteljau(np.abs(x[:, :5].astype(float)), np.stack([1 - x[:, 5].astype(float), x[:, 5]], -1), d=1)

@@ -223,7 +223,7 @@ def test_glsl_cubic_and_newton3_vs_float32_twins(ray_cubics):
     body = ("float c[5] = float[5](sv_in[0], sv_in[1], sv_in[2], sv_in[3], 0.0);"
             "sv_out[0] = sv_first_root_cubic(c); sv_out[1] = sv_first_root_newton3(c, 5);"
             "sv_out[2] = sv_first_root_newton3(c, 3);")
-    g = run_glsl('#include "lib/roots.glsl"\n', body, c, 3)
+    g = run_glsl('#include "lib/core/roots.glsl"\n', body, c, 3)
     g = np.where(g == -1.0, np.nan, g)
     # Newton from three starts: only + - * / and comparisons -> bit-identical to the float32 twin
     # (the twin rejects non-finite input, like newton_secure's: the last row is left out)

@@ -1,10 +1,7 @@
-"""The volume isosurface program on the GPU (glsl/programs/isosurface.glsl) against its float64 twin.
-
-Every comparison renders the isosurface alone and checks, per pixel (splinevis.analysis.agreement):
-no leaks (a GPU miss whose reference and all 8 neighbours hit: a crack), at most 0.1 % of pixels where
-exactly one side hits (silhouette pixels where the ray grazes the surface within rounding), and at least
-99.9 % of the depths within the derived per-pixel bound
-(splinevis.analysis.bounds.isosurface_depth_error_bound).
+"""The volume isosurface program on the GPU (glsl/programs/isosurface.glsl) beyond the per-pixel hard cases
+(those are in splinevis.volume.hard_cases, checked by tests/test_program_hard_cases.py): the paper's root
+finder, empty and constant scenes, input errors, the isovalue changed in place, culling, curvature and
+colour outputs against the twin, translucency.
 """
 
 from __future__ import annotations
@@ -15,54 +12,17 @@ import numpy as np
 import pytest
 
 import splinevis
-from splinevis.analysis.agreement import depth_agreement
+from splinevis.analysis.agreement import agreement_failures, depth_agreement, hard_case_agreement
+from splinevis.gl.contract import HardCase
 from splinevis.io.volumes import VolumeGrid
-from splinevis.volume.model import MIN_SAMPLES, SCHEME_DEGREE, VolumeSpline
+from splinevis.volume.hard_cases import CAMERA as CAM
+from splinevis.volume.hard_cases import sphere_grid
+from splinevis.volume.model import MIN_SAMPLES, VolumeSpline
 from splinevis.volume.program import Isosurface, isosurface_program
 
 pytestmark = pytest.mark.gl
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def sphere_grid(n=20, radius=0.7, spacing=None, origin=None, dtype=np.float64, noise=0.0):
-    x = np.linspace(-1, 1, n)
-    z, y, xx = np.meshgrid(x, x, x, indexing="ij")
-    v = np.sqrt(xx ** 2 + y ** 2 + z ** 2)
-    if noise:
-        v = v + np.random.default_rng(0).normal(scale=noise, size=v.shape)
-    h = 2.0 / (n - 1)
-    sp = np.array(spacing if spacing is not None else (h, h, h), dtype=float)
-    org = np.array(origin if origin is not None else -1.0 * sp * (n - 1) / 2)
-    return VolumeGrid(v.astype(dtype), spacing=tuple(sp), origin=tuple(org))
-
-
-def agreement(model, camera, size=(160, 120), options=None, iterations=6):
-    orig = splinevis.Plotter.add_spline
-
-    def hook(pl):  # depth_agreement adds the model itself; pass program options through a hook
-        return None
-
-    if options:
-        def add(self, m, style=None, **kw):
-            kw["program_options"] = options
-            kw["newton_iterations"] = iterations
-            return orig(self, m, style, **kw)
-
-        splinevis.Plotter.add_spline = add
-    try:
-        r = depth_agreement(model, camera, size, newton_iterations=iterations, plotter_hook=hook)
-    finally:
-        splinevis.Plotter.add_spline = orig
-    return r
-
-
-def check(r, min_hits=500):
-    assert r["both"] >= min_hits, r["both"]
-    assert r["leaks"] == 0, r["leaks"]
-    assert r["hit_disagree"] <= 0.001 * r["pixels"], r["hit_disagree"]
-    within = float(np.mean(r["depth_error"] <= r["depth_bound"]))
-    assert within >= 0.999, (within, float(np.max(r["depth_error"] / r["depth_bound"])))
 
 
 def test_generated_glsl_is_current():
@@ -75,17 +35,6 @@ def test_generated_glsl_is_current():
         assert (ROOT / "glsl" / "lib" / name).read_text() == text, f"run python tools/gen_volume_glsl.py ({name} is stale)"
 
 
-CAM = [(3.0, 2.0, 2.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
-
-
-@pytest.mark.parametrize("options", [{}, {"encoding": "coefficients"}, {"roots": "bracketed"}, {"proxy": "cubes"},
-                                     {"proxy": "cubes", "encoding": "coefficients"}, {"block_size": 3}],
-                         ids=["blocks-data-analytic", "blocks-table", "bracketed", "cubes", "cubes-table", "blocks-of-3"])
-def test_quadratic_sphere_matches_twin(options):
-    iso = Isosurface(VolumeSpline(sphere_grid()), 0.7)
-    check(agreement(iso, CAM, options=options))
-
-
 def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     # Paper 003's fixed-iteration Newton from three starts (0, the inflection point or 1/2, 1) has no
     # bracket: a start that has not converged fails the residual test, and the smallest ACCEPTED iterate can
@@ -94,7 +43,7 @@ def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     # the true surface or where there is none, and it is right (within the bound) on almost all pixels;
     # the 5 % ceiling is a regression guard on a measured rate, not a derived tolerance.
     iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
-    r = agreement(iso, CAM, options={"roots": "paper"}, iterations=5)
+    r = depth_agreement(iso, CAM, (160, 120), newton_iterations=5, program_options={"roots": "paper"})
     ref_hit = np.isfinite(r["reference_depth"])
     gpu_hit = r["gpu_depth"] < 1.0
     assert not (gpu_hit & ~ref_hit).any()
@@ -102,67 +51,6 @@ def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     wrong = r["depth_error"] > r["depth_bound"]
     assert np.all(r["gpu_depth"][both][wrong] > r["reference_depth"][both][wrong])  # later, not earlier
     assert wrong.mean() + (ref_hit & ~gpu_hit).sum() / ref_hit.sum() <= 0.05
-
-
-@pytest.mark.parametrize("options", [{}, {"roots": "bracketed"}, {"proxy": "cubes"}, {"encoding": "determining"},
-                                     {"encoding": "determining", "proxy": "cubes"}],
-                         ids=["analytic", "bracketed", "cubes", "determining-set", "determining-set-cubes"])
-def test_cubic_sphere_matches_twin(options):
-    assert "cubic" in SCHEME_DEGREE
-    iso = Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7)
-    check(agreement(iso, CAM, options=options))
-
-
-def test_anisotropic_spacing_and_utm_sized_origin():
-    g = sphere_grid(spacing=(0.05, 0.12, 0.08), origin=(5.0e5, 4.2e6, 1.0e3))
-    iso = Isosurface(VolumeSpline(g), 0.7)
-    c = np.array(VolumeSpline(g).bounds).reshape(3, 2).mean(axis=1)
-    check(agreement(iso, [tuple(c + [3.0, 2.0, 2.5]), tuple(c), (0, 0, 1)]))
-
-
-def test_huge_spacing():
-    g = sphere_grid(spacing=(1.0e3, 1.0e3, 1.0e3), origin=(0.0, 0.0, 0.0))
-    s = VolumeSpline(g)
-    c = np.array(s.bounds).reshape(3, 2).mean(axis=1)
-    check(agreement(Isosurface(s, 0.7), [tuple(c + np.array([3.0, 2.0, 2.5]) * 8e3), tuple(c), (0, 0, 1)]))
-
-
-def test_camera_inside_the_volume():
-    # the eye sits inside the domain (outside the sphere): proxies of cubes around and behind the eye
-    # are clipped by the near plane; back faces still produce the fragments.
-    iso = Isosurface(VolumeSpline(sphere_grid(n=24)), 0.5)
-    check(agreement(iso, [(0.9, 0.1, 0.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]), min_hits=2000)
-
-
-def test_noisy_data():
-    iso = Isosurface(VolumeSpline(sphere_grid(noise=0.02)), 0.7)
-    check(agreement(iso, CAM))
-
-
-@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.int16, np.float32])
-def test_integer_and_float32_data(dtype):
-    g = sphere_grid()
-    scale = {np.uint8: 200.0, np.uint16: 40000.0, np.int16: 20000.0, np.float32: 1.0}[dtype]
-    q = VolumeGrid(np.round(g.values * scale).astype(dtype) if dtype != np.float32 else g.values.astype(dtype),
-                   spacing=g.spacing, origin=g.origin)
-    check(agreement(Isosurface(VolumeSpline(q), 0.7 * scale + 0.5), CAM))
-
-
-def test_plateau_at_the_isovalue_and_thin_sheet():
-    # a plateau: data exactly equal to the isovalue on a block (every coefficient there equals it); the
-    # first point of the plateau along the ray is a root (s - iso = 0) and both sides agree on it.
-    n = 16
-    v = np.zeros((n, n, n))
-    v[4:12, 4:12, 4:12] = 1.0
-    v[6:10, 6:10, 6:10] = 2.0
-    iso = Isosurface(VolumeSpline(VolumeGrid(v)), 1.0)
-    check(agreement(iso, [(30.0, 22.0, 26.0), (7.5, 7.5, 7.5), (0, 0, 1)]), min_hits=300)
-    # a sheet one voxel thick (x = 8): an isosurface on both sides of the sheet, seen from the side
-    w = np.zeros((n, n, n))
-    w[:, :, 8] = 1.0
-    iso = Isosurface(VolumeSpline(VolumeGrid(w)), 0.5)
-    r = agreement(iso, [(30.0, 14.0, 10.0), (7.5, 7.5, 7.5), (0, 0, 1)])
-    check(r, min_hits=2000)
 
 
 def test_isovalue_outside_the_data_is_an_empty_scene():
@@ -207,7 +95,7 @@ def test_options_are_validated():
         isosurface_program(iso, encoding="texture")
     with pytest.raises(ValueError, match="roots"):
         isosurface_program(iso, roots="cardano")
-    with pytest.raises(ValueError, match="for quadratics the paper"):
+    with pytest.raises(ValueError, match="roots='paper' does not solve degree-2 polynomials.*use one of 'analytic', 'bracketed'"):
         isosurface_program(iso, roots="paper")
     with pytest.raises(ValueError, match="56 determining coefficients"):
         isosurface_program(iso, encoding="determining")
@@ -238,8 +126,9 @@ def test_changing_the_isovalue_keeps_octree_data_texture_and_program():
     # the sphere of radius 0.4 covers (0.4 / 0.7)^2 of the pixels of the one of radius 0.7 (same view)
     assert abs(small / big - (0.4 / 0.7) ** 2) < 0.08
     # and its depth agrees with a fresh build at 0.4
-    r = agreement(Isosurface(s, 0.4), CAM)
-    check(r, min_hits=300)
+    case = HardCase("isovalue-0.4", lambda: Isosurface(s, 0.4), CAM, min_hits=300 / 19200)
+    r = hard_case_agreement(case)
+    assert agreement_failures(r, case) == []
     assert np.allclose(pl.depth_buffer()[pl.depth_buffer() < 1], r["gpu_depth"][pl.depth_buffer() < 1], atol=1e-6)
     pl.close()
 
@@ -265,7 +154,7 @@ def test_frustum_culling_draws_fewer_cubes_and_the_same_image():
 
 def _render_style_and_twin(iso, size=(160, 120), program_options=None, **style):
     """Image of the isosurface with ``style`` and, per pixel, the float64 twin's hit points (NaN if none)."""
-    from splinevis.analysis.rays import pixel_rays
+    from splinevis.gl.camera import pixel_rays
     from splinevis.volume.raycast import raycast_isosurface
 
     pl = splinevis.Plotter(off_screen=True, window_size=size)
@@ -276,9 +165,7 @@ def _render_style_and_twin(iso, size=(160, 120), program_options=None, **style):
     gpu_hit = pl.depth_buffer() < 1.0
     o, d = pixel_rays(pl.camera_matrix(), *size)
     pl.close()
-    t, _ = raycast_isosurface(iso, o.reshape(-1, 3), d.reshape(-1, 3))
-    p = (o.reshape(-1, 3) + t[:, None] * d.reshape(-1, 3)).reshape(o.shape)
-    return img, gpu_hit, p
+    return img, gpu_hit, raycast_isosurface(iso, o, d).points
 
 
 def _near_tet_face(spline, p, tol):

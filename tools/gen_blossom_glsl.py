@@ -1,4 +1,4 @@
-"""Generate glsl/lib/blossom_steps.glsl: de Casteljau steps of quartic triangle patches, unrolled.
+"""Generate glsl/lib/simplex/blossom_steps.glsl: de Casteljau steps of quartic triangle patches, unrolled.
 
 Each step of fixed degree gets its own function with constant indices, so the shader compiler keeps
 the arrays in registers (dynamic indexing of local arrays spills to memory on llvmpipe and is several
@@ -12,7 +12,7 @@ import numpy as np
 
 from splinevis.bb.simplex import multi_indices
 
-OUT = Path(__file__).resolve().parents[1] / "glsl" / "lib" / "blossom_steps.glsl"
+OUT = Path(__file__).resolve().parents[1] / "glsl" / "lib" / "simplex" / "blossom_steps.glsl"
 
 
 def index(m):

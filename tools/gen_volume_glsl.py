@@ -1,13 +1,13 @@
-"""Generate the GLSL of the volume isosurface program from the float64 definitions (issue 4).
+"""Generate the GLSL of the volume isosurface program from the float64 definitions.
 
 Writes, under glsl/lib/:
 
-* ``type6.glsl`` -- the 24 barycentric matrices of the type-6 split (splinevis.volume.partition) as a
+* ``type6/partition.glsl`` -- the 24 barycentric matrices of the type-6 split (splinevis.volume.partition) as a
   constant table: ``lam_i = dot(SV_TET_BARY[4 t + i], vec4(local, 1))``;
-* ``tet_steps.glsl`` -- de Casteljau steps of tetrahedral BB polynomials of degree 3 -> 2 -> 1 -> 0 with
+* ``simplex/tet_steps.glsl`` -- de Casteljau steps of tetrahedral BB polynomials of degree 3 -> 2 -> 1 -> 0 with
   constant indices (no dynamic indexing of local arrays: that spills to memory on llvmpipe), and the
   restriction of a quadratic or cubic to a segment by blossoming (paper 003, sec. 5.3, Fig. 10);
-* ``volume_stencil_<scheme>.glsl`` -- ``sv_tet_coefficients(t, f, b)``: the BB coefficients of
+* ``type6/stencil_<scheme>.glsl`` and ``type6/determining_cubic.glsl`` -- ``sv_tet_coefficients(t, f, b)``: the BB coefficients of
   tetrahedron t of a cube from the cube's 27 data values (the scheme's averaging rules, paper 003 sec. 4
   eq. (3) and Fig. 7, as the fixed weights of splinevis.volume.schemes.tet_weights): tetrahedron 0's rules,
   weights grouped by value, applied to the data permuted by the cube symmetry taking tetrahedron 0 to t.
@@ -222,10 +222,10 @@ def stencil(scheme: str) -> str:
 
 
 def generate() -> dict:
-    files = {"type6.glsl": type6(), "tet_steps.glsl": tet_steps()}
+    files = {"type6/partition.glsl": type6(), "simplex/tet_steps.glsl": tet_steps()}
     for scheme in SCHEME_DEGREE:
-        files[f"volume_stencil_{scheme}.glsl"] = stencil(scheme)
-    files["volume_determining_cubic.glsl"] = determining("cubic")
+        files[f"type6/stencil_{scheme}.glsl"] = stencil(scheme)
+    files["type6/determining_cubic.glsl"] = determining("cubic")
     return files
 
 

@@ -1,26 +1,27 @@
 // Ray casting one quartic BB triangle patch z = f(x, y) (the foundation's analytic test surface and the
 // per-patch core of the terrain program; paper 000, sec. V-VI).
 //
-// Steps 1-3 are lib/graph_patch.glsl (shared with every terrain triangle):
+// Steps 1-3 are lib/simplex/graph_patch.glsl (shared with every terrain triangle):
 // 1. Clip the ray against the prism over the triangle between the smallest and largest coefficient
 //    (the convex-hull property bounds f there).
 // 2. Restrict f to the projected segment by blossoming (paper 000, eq. (6)-(7)): five univariate BB
 //    coefficients; subtract the ray's height, itself degree-elevated to a quartic.
-// 3. First root in [0,1] (lib/roots.glsl sv_first_root): bracketed Newton on convex pieces, or paper
-//    000's Newton from secure starting points when SV_ROOTS_PAPER_NEWTON is defined.
-// 4. Value, gradient (and Hessian for curvature) by de Casteljau at the hit (lib/bb_triangle.glsl).
-#include "lib/raycast.glsl"
-#include "lib/bb_triangle.glsl"
-#include "lib/graph_patch.glsl"
+// 3. First root in [0,1] (lib/core/roots.glsl sv_first_root): bracketed Newton on convex pieces, or paper
+//    000's Newton from secure starting points when SV_ROOTS_PAPER is defined.
+// 4. Value, gradient (and Hessian for curvature) by de Casteljau at the hit (lib/simplex/bb_triangle.glsl).
+#include "lib/core/raycast.glsl"
+#include "lib/core/table.glsl"
+#include "lib/simplex/bb_triangle.glsl"
+#include "lib/simplex/graph_patch.glsl"
 
 #ifdef SV_PATCH_TEXTURE
-// Coefficients from an RGBA32F table (VTK declares the sampler sv_patch_coeffs): row = patch id, texels
-// 0..3 hold the 15 coefficients (+1 padding). The patch id is a flat vertex attribute of the proxy.
+// Coefficients from a table (lib/core/table.glsl; VTK declares the sampler sv_patch_coeffs): patch id p's 15
+// coefficients (+1 padding) are texels 4 p .. 4 p + 3. The patch id is a flat vertex attribute of the proxy.
 // This is the path terrains and volumes use for millions of patches; here it proves the plumbing.
 void sv_patch_load(out float b[15]) {
     int row = int(sv_patch_idVSOut + 0.5);
     for (int q = 0; q < 4; ++q) {
-        vec4 v = texelFetch(sv_patch_coeffs, ivec2(q, row), 0);
+        vec4 v = sv_table_texel(sv_patch_coeffs, 4 * row + q);
         for (int r = 0; r < 4; ++r) {
             if (4 * q + r < 15) b[4 * q + r] = v[r];
         }

@@ -16,19 +16,20 @@
 // 4. the smallest t over the tetrahedra wins in the cube; across cubes the depth test picks the first.
 // Normal: gradient of s from the degree n - 1 coefficients at the hit (paper 003, sec. 5.3, last para).
 // The float64 twin is splinevis.volume.raycast.
-#include "lib/raycast.glsl"
-#include "lib/roots.glsl"
-#include "lib/type6.glsl"
-#include "lib/tet_steps.glsl"
+#include "lib/core/raycast.glsl"
+#include "lib/core/table.glsl"
+#include "lib/core/roots.glsl"
+#include "lib/type6/partition.glsl"
+#include "lib/simplex/tet_steps.glsl"
 #ifdef SV_VOLUME_CUBIC
-#include "lib/volume_stencil_cubic.glsl"
+#include "lib/type6/stencil_cubic.glsl"
 #else
-#include "lib/volume_stencil_quadratic.glsl"
+#include "lib/type6/stencil_quadratic.glsl"
 #endif
 #ifdef SV_VOLUME_DETERMINING
 // Paper 003's encoding: per relevant cube only its 56 determining coefficients (sampler sv_volume_det, one
 // row of 56 floats per cube); the rest follow from them in the shader.
-#include "lib/volume_determining_cubic.glsl"
+#include "lib/type6/determining_cubic.glsl"
 const int SV_CUBE_VALUES = 56;
 #else
 const int SV_CUBE_VALUES = 27;
@@ -40,7 +41,6 @@ uniform float sv_value_ref;
 uniform int sv_newton_iterations;
 uniform float sv_cube_margin;     // clip margins in barycentric units: lam_0 (the face on the cube's boundary)
 uniform float sv_inner_margin;    // and lam_1..3 (faces inside the cube), see splinevis.volume.program
-uniform int sv_tex_width;         // texels per row of the data / coefficient texture
 uniform vec3 sv_padded_dims;      // (nx + 2, ny + 2, nz + 2)
 uniform vec3 sv_cube_count;       // (nx, ny, nz): hit.uv = (x, y) / (nx, ny)
 #ifdef SV_VOLUME_BLOCKS
@@ -52,22 +52,18 @@ const int SV_MAX_BLOCK = 16;      // largest supported block edge (loop bound of
 // A second field on the same grid (the sampler sv_color_data, same layout as sv_volume_data): the
 // isosurface is coloured by its spline (same scheme) at the hit; hit.scalar feeds the colormap effect.
 float sv_fetch_color(int n) {
-    int texel = n / 4;
-    vec4 v = texelFetch(sv_color_data, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
-    return v[n - 4 * texel];
+    return sv_table_float(sv_color_data, n);
 }
 #endif
 
 float sv_fetch_linear(int n) {
-    int texel = n / 4;
 #if defined(SV_VOLUME_TABLE)
-    vec4 v = texelFetch(sv_volume_coef, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+    return sv_table_float(sv_volume_coef, n);
 #elif defined(SV_VOLUME_DETERMINING)
-    vec4 v = texelFetch(sv_volume_det, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+    return sv_table_float(sv_volume_det, n);
 #else
-    vec4 v = texelFetch(sv_volume_data, ivec2(texel % sv_tex_width, texel / sv_tex_width), 0);
+    return sv_table_float(sv_volume_data, n);
 #endif
-    return v[n - 4 * texel];
 }
 
 #ifdef SV_VOLUME_TABLE
@@ -119,10 +115,10 @@ void sv_load_cube(ivec3 c, int row, out float f[SV_CUBE_VALUES]) {
 }
 
 // First root in [0, 1] of the restricted polynomial minus the isovalue: the stable closed form of the
-// degree (default), paper 003's Newton from three starts (SV_ROOTS_PAPER_NEWTON3), or bracketed Newton on
+// degree (default), paper 003's Newton from three starts (SV_ROOTS_PAPER), or bracketed Newton on
 // convex pieces (SV_ROOTS_BRACKETED); the float64/float32 twins are in splinevis.bb.roots.
 float sv_first_root_deg(float c[5]) {
-#if defined(SV_ROOTS_PAPER_NEWTON3)
+#if defined(SV_ROOTS_PAPER)
     return sv_first_root_newton3(c, sv_newton_iterations);
 #elif defined(SV_ROOTS_BRACKETED)
     return sv_first_root_bracketed(c, SV_VOL_DEGREE, sv_newton_iterations);
@@ -238,7 +234,7 @@ float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin,
 // 12-bit halves. `a` is the cube within block `block`.
 vec4 sv_cube_info(int block, ivec3 a) {
     int k = (block * sv_block_size + a.z) * sv_block_size * sv_block_size + a.y * sv_block_size + a.x;
-    return texelFetch(sv_volume_mask, ivec2(k % sv_tex_width, k / sv_tex_width), 0);
+    return sv_table_texel(sv_volume_mask, k);
 }
 #endif
 

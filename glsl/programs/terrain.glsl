@@ -1,4 +1,4 @@
-// Ray casting a quartic terrain spline (paper 000) through a min/max hierarchy, per fragment.
+// Ray casting a quartic terrain spline [Reis2008] through a min/max hierarchy, per fragment.
 //
 // Proxy: one box around the whole terrain, rasterized with front faces culled. Each fragment's ray is
 // taken to index space (u, v in spline cells, z = height relative to the reference height) and walks a
@@ -8,15 +8,17 @@
 // programs/analytic_patch.glsl (clip, restrict by blossoming, first root, paper 000 sec. VI). The frame
 // cost grows with the number of blocks a ray visits (~ log of the grid size for most rays), not with
 // the patch count. The float64 reference is splinevis.terrain.raycast (a plain cell-by-cell DDA).
-#include "lib/raycast.glsl"
-#include "lib/bb_triangle.glsl"
-#include "lib/graph_patch.glsl"
+#include "lib/core/raycast.glsl"
+#include "lib/core/table.glsl"
+#include "lib/simplex/bb_triangle.glsl"
+#include "lib/simplex/graph_patch.glsl"
 
-// VTK declares the samplers of the textures set on the actor: sv_terrain_coef (RGBA32F, 8 texels per
-// cell: T0's 15 then T1's 15 coefficients, row = cell j, texel 8 i + q) and sv_terrain_minmax
-// (RGBA32F atlas of the hierarchy: level L's block (bi, bj) at texel (sv_level_offset[L] + bi, bj), .rg =
-// (min, max)).
+// VTK declares the samplers of the textures set on the actor, both tables (lib/core/table.glsl):
+// sv_terrain_coef (8 texels per cell, cells row after row: T0's 15 then T1's 15 coefficients, 2 zeros) and
+// sv_terrain_minmax (the hierarchy, level after level: level L's block (bi, bj) at texel
+// sv_level_offset[L] + bj * sv_level_width[L] + bi, .rg = (min, max)).
 uniform float sv_level_offset[16];
+uniform float sv_level_width[16];
 uniform int sv_top_level;
 uniform vec2 sv_ncells;            // (ncx, ncy)
 uniform vec2 sv_index_scale;       // u = sv_index_scale.x * x_mc + sv_index_shift.x (likewise v)
@@ -27,13 +29,14 @@ uniform int sv_newton_iterations;
 uniform float sv_scalar_offset;    // reference height: hit.scalar is the physical height (colormaps)
 
 vec2 sv_block_minmax(int level, ivec2 b) {
-    return texelFetch(sv_terrain_minmax, ivec2(int(sv_level_offset[level]) + b.x, b.y), 0).rg;
+    return sv_table_texel(sv_terrain_minmax, int(sv_level_offset[level]) + b.y * int(sv_level_width[level]) + b.x).rg;
 }
 
 void sv_load_cell(ivec2 c, out float b0[15], out float b1[15]) {
     float w[32];
+    int first = 8 * (c.y * int(sv_ncells.x) + c.x);
     for (int q = 0; q < 8; ++q) {
-        vec4 v = texelFetch(sv_terrain_coef, ivec2(8 * c.x + q, c.y), 0);
+        vec4 v = sv_table_texel(sv_terrain_coef, first + q);
         w[4 * q] = v.x; w[4 * q + 1] = v.y; w[4 * q + 2] = v.z; w[4 * q + 3] = v.w;
     }
     for (int q = 0; q < 15; ++q) {
@@ -54,7 +57,7 @@ vec3 sv_cell_bary(vec2 p, int tri) {
 const float SV_CELL_MARGIN = 1.52587890625e-05;
 
 // First hit (t in [ta, tb]) of the cell-local ray o + t d with triangle `tri`; SV_NO_HIT if none
-// (t may be negative: rays start on the far side of the proxy, see lib/raycast.glsl).
+// (t may be negative: rays start on the far side of the proxy, see lib/core/raycast.glsl).
 float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
     vec3 lo = sv_cell_bary(o.xy, tri);
     vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);

@@ -1,18 +1,22 @@
-"""Does the ray-cast surface composite correctly with ordinary meshes? GPU against float64, per pixel.
+"""Does a ray-cast surface composite correctly with ordinary meshes? GPU against float64, per pixel.
 
-The scene is the showcase one: the analytic patch, unlit red, and a sphere mesh, unlit blue, cutting
-through it. The GPU image says per pixel which surface is in front. The reference says the same from
-the patch's float64 ray-cast depth and the sphere's own rasterized depth (the sphere is an ordinary
-mesh: its depth is whatever the rasterizer makes of it, read back from a render of the sphere alone).
+The scene (built by the caller, e.g. the showcase's patch and a sphere cutting through it) holds one spline,
+drawn unlit red (:data:`UNLIT`), and ordinary meshes, drawn here unlit blue. The GPU image says per pixel
+which surface is in front. The reference says the same from the spline's float64 ray-cast depth (its
+program's twin) and the meshes' own rasterized depth (an ordinary mesh's depth is whatever the rasterizer
+makes of it, read back from a render of the meshes alone).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rays import pixel_rays, window_depth
+from ..gl.camera import pixel_rays, window_depth
 
-__all__ = ["front_surface_agreement", "patch_depth_agreement"]
+__all__ = ["front_surface_agreement", "reference_depth", "UNLIT"]
+
+#: The spline's style in a compositing check: unlit pure red.
+UNLIT = dict(lights=0, color=(1.0, 0.0, 0.0))
 
 BACKGROUND, PATCH, SPHERE = 0, 1, 2
 
@@ -25,26 +29,25 @@ def _classify(rgb: np.ndarray) -> np.ndarray:
     return out
 
 
-def reference_patch_depth(patch, matrix, width, height, *, method="reference"):
-    """(H, W) float64 window depth of the patch (NaN where the ray misses)."""
+def reference_depth(model, matrix, width, height, *, method="reference"):
+    """(H, W) float64 window depth of the model by its program's float64 twin (NaN where the ray misses)."""
+    from .agreement import reference_hits
+
     o, d = pixel_rays(matrix, width, height)
-    hits = patch.raycast(o, d, 0.0, method=method)
+    hits = reference_hits(model, o, d, method=method)
     return window_depth(matrix, o + hits.t[..., None] * d)
 
 
-def front_surface_agreement(window_size=(640, 480)) -> dict:
-    """Render the composite scene and compare the front surface per pixel with the float64 reference.
+def front_surface_agreement(pl, model) -> dict:
+    """Render the scene of Plotter ``pl`` (one spline of ``model`` styled :data:`UNLIT`, and meshes) and compare
+    the front surface per pixel with the float64 reference; closes ``pl``.
 
     Returns a dict with ``gpu_front``, ``reference_front`` (H, W int arrays: 0 background, 1 patch,
     2 sphere), ``disagree`` (bool), ``compared`` (pixels where either says a surface is present),
     ``disagree_count``, ``agreement`` (fraction) and ``both_ways`` (pixels where the sphere is in front
     of a patch point and where the patch is in front of a sphere point, per the reference).
     """
-    from ..studies.demo import composite_scene
-
-    w, h = window_size
-    unlit = dict(lights=0, color=(1.0, 0.0, 0.0))
-    pl, patch, _ = composite_scene(window_size, style=unlit)
+    w, h = pl.window_size
     for actor in pl.renderer.actors.values():
         if actor.GetMapper().GetClassName() != "vtkOpenGLPolyDataMapper":
             actor.GetProperty().SetColor(0.0, 0.0, 1.0)
@@ -58,7 +61,7 @@ def front_surface_agreement(window_size=(640, 480)) -> dict:
     sphere_depth = pl.depth_buffer()
     pl.close()
 
-    patch_depth = reference_patch_depth(patch, matrix, w, h)
+    patch_depth = reference_depth(model, matrix, w, h)
     sphere_present = sphere_depth < 1.0
     ref = np.full((h, w), BACKGROUND, dtype=np.int8)
     patch_present = np.isfinite(patch_depth) & (patch_depth >= 0) & (patch_depth <= 1)
@@ -79,14 +82,3 @@ def front_surface_agreement(window_size=(640, 480)) -> dict:
         "agreement": 1.0 - disagree.sum() / max(n, 1),
         "both_ways": (int((both & (sphere_depth < patch_depth)).sum()), int((both & (patch_depth < sphere_depth)).sum())),
     }
-
-
-def patch_depth_agreement(window_size=(640, 480), camera=None, newton_iterations=8) -> dict:
-    """Render the showcase patch alone; compare hit/miss and window depth with the float64 reference
-    (:func:`splinevis.analysis.agreement.depth_agreement` at the showcase camera)."""
-    from ..analytic import QuarticTrianglePatch
-    from ..studies.demo import CAMERA
-    from .agreement import depth_agreement
-
-    return depth_agreement(QuarticTrianglePatch.demo(), camera if camera is not None else CAMERA, window_size,
-                           newton_iterations=newton_iterations)

@@ -1,5 +1,5 @@
 """Analytic test surfaces with exact float64 ray casters (the foundation's first spline actor)."""
 
-from .patch import QuarticTrianglePatch, RayHits
+from .patch import QuarticTrianglePatch
 
-__all__ = ["QuarticTrianglePatch", "RayHits"]
+__all__ = ["QuarticTrianglePatch"]

@@ -17,22 +17,11 @@ import numpy as np
 from .._validation import as_float64_array, check_choice
 from ..bb import simplex as _simplex
 from ..bb.ray import graph_patch_first_hit
+from ..gl.contract import RayHits
 
-__all__ = ["QuarticTrianglePatch", "RayHits"]
+__all__ = ["QuarticTrianglePatch"]
 
 DEGREE = 4
-
-
-class RayHits:
-    """Result of a float64 ray cast: ``t`` (NaN for a miss), ``points`` (…, 3), ``normals`` (…, 3)."""
-
-    __slots__ = ("t", "points", "normals", "hit")
-
-    def __init__(self, t, points, normals):
-        self.t = t
-        self.points = points
-        self.normals = normals
-        self.hit = np.isfinite(t)
 
 
 class QuarticTrianglePatch:
@@ -178,17 +167,17 @@ class QuarticTrianglePatch:
             Rays ``o + t d``; directions need not be unit.
         tmin : float or (…) array_like
             Smallest admissible t (0 for perspective rays starting at the eye, -inf for parallel rays).
-        method : {"reference", "gpu", "paper"}
-            ``"gpu"`` mirrors the shader's default root finder (bracketed Newton on the convex pieces
+        method : {"reference", "bracketed", "paper"}
+            ``"bracketed"`` mirrors the shader's default root finder (bracketed Newton on the convex pieces
             between the secure starting points, ``iterations`` steps); ``"paper"`` is paper 000's
-            four-start Newton (``SV_ROOTS_PAPER_NEWTON``); ``"reference"`` takes the first root from
+            four-start Newton (``SV_ROOTS_PAPER``); ``"reference"`` takes the first root from
             the robust all-roots finder.
 
         Returns
         -------
         RayHits
         """
-        check_choice(method, "method", {"reference", "gpu", "paper"})
+        check_choice(method, "method", {"reference", "bracketed", "paper"})
         o = as_float64_array(origins, "origins", shape_tail=(3,))
         d = as_float64_array(directions, "directions", shape_tail=(3,))
         o, d = np.broadcast_arrays(o, d)

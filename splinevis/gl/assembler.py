@@ -1,7 +1,7 @@
 """GLSL program assembly: ``#include`` resolution, compile-time flags, a cache, and line origins.
 
 Shader code lives in small files under ``glsl/`` (shipped as ``splinevis.glsl``). A file pulls in another
-with ``#include "lib/bernstein.glsl"`` (path relative to the ``glsl/`` root). Each file is included at
+with ``#include "lib/core/bernstein.glsl"`` (path relative to the ``glsl/`` root). Each file is included at
 most once per program, so files can include what they use without guards. Compile-time flags become
 ``#define`` lines at the top; effects and program variants are selected with ``#ifdef`` in the files,
 so code of an effect that a scene does not declare never reaches the driver. The assembler itself
@@ -13,7 +13,7 @@ names pass through to the GLSL preprocessor untouched.
 The same assembled text serves VTK (spliced into vtkOpenGLPolyDataMapper's template by
 :mod:`splinevis.gl.inject`) and moderngl (:mod:`splinevis.gl.harness`); both wrap it with their own
 ``#version`` line. Every output line remembers the file and line it came from, so a compile error can be
-reported against ``glsl/lib/roots.glsl:42`` rather than line 731 of VTK's expanded program.
+reported against ``glsl/lib/core/roots.glsl:42`` rather than line 731 of VTK's expanded program.
 """
 
 from __future__ import annotations
@@ -169,18 +169,21 @@ def _strip_sv_conditionals(lines, origins, defined: set, name: str):
     return out, out_origins
 
 
-def _read(root: Path, rel: str, chain: tuple) -> list[str]:
-    path = root / rel
-    if not path.is_file():
-        where = f" (included from {chain[-1]})" if chain else ""
-        raise ShaderIncludeError(
-            f"GLSL file {rel!r}{where} not found under {root}. Include paths are relative to the glsl/ "
-            "folder, e.g. #include \"lib/bernstein.glsl\"."
-        )
-    return path.read_text().splitlines()
+def _read(roots: tuple, rel: str, chain: tuple) -> list[str]:
+    for root in roots:
+        path = root / rel
+        if path.is_file():
+            return path.read_text().splitlines()
+    where = f" (included from {chain[-1]})" if chain else ""
+    under = " or ".join(str(r) for r in roots)
+    raise ShaderIncludeError(
+        f"GLSL file {rel!r}{where} not found under {under}. Include paths are relative to the glsl/ "
+        "folder, e.g. #include \"lib/core/bernstein.glsl\"."
+    )
 
 
-def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: Path | None = None) -> Assembled:
+def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: Path | None = None,
+             extra_roots: tuple = ()) -> Assembled:
     """Assemble a GLSL block from ``entry`` with compile-time ``defines``.
 
     Parameters
@@ -193,6 +196,9 @@ def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: P
         undefined.
     root : Path, optional
         Another GLSL root (tests use a temporary one). Defaults to :func:`glsl_root`.
+    extra_roots : tuple of Path, optional
+        Folders searched before ``root``: a spline family outside the package ships its own GLSL files
+        there and includes the shipped library as usual.
 
     Returns
     -------
@@ -202,8 +208,8 @@ def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: P
     Examples
     --------
     >>> from splinevis.gl.assembler import assemble
-    >>> block = assemble('#include "lib/bernstein.glsl"\\n', {"SV_DEGREE": 4})
-    >>> "lib/bernstein.glsl" in block.files
+    >>> block = assemble('#include "lib/core/bernstein.glsl"\\n', {"SV_DEGREE": 4})
+    >>> "lib/core/bernstein.glsl" in block.files
     True
     >>> "#define SV_DEGREE 4" in block.text
     True
@@ -211,12 +217,13 @@ def assemble(entry: str, defines: Mapping[str, object] | None = None, *, root: P
     key = tuple(sorted((defines or {}).items()))
     for name, value in key:
         _format_define(name, value)  # validate before the cache so bad flags always raise
-    return _assemble_cached(entry, key, str(root) if root is not None else None)
+    extra = tuple(str(r) for r in extra_roots)
+    return _assemble_cached(entry, key, str(root) if root is not None else None, extra)
 
 
 @functools.lru_cache(maxsize=256)
-def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
-    root = Path(root_str) if root_str is not None else glsl_root()
+def _assemble_cached(entry: str, key: tuple, root_str: str | None, extra: tuple = ()) -> Assembled:
+    roots = tuple(Path(r) for r in extra) + (Path(root_str) if root_str is not None else glsl_root(),)
     is_text = "\n" in entry
     name = "<string>" if is_text else entry
     out: list[str] = [BEGIN_MARKER + name]
@@ -249,12 +256,12 @@ def _assemble_cached(entry: str, key: tuple, root_str: str | None) -> Assembled:
             seen.append(target)
             out.append(f"// --- {target}")
             origins.append((target, 0))
-            expand(_read(root, target, chain + (rel,)), target, chain + (target,))
+            expand(_read(roots, target, chain + (rel,)), target, chain + (target,))
 
     if is_text:
         expand(entry.splitlines(), "<string>", ())
     else:
         seen.append(entry)
-        expand(_read(root, entry, ()), entry, (entry,))
+        expand(_read(roots, entry, ()), entry, (entry,))
     out, origins = _strip_sv_conditionals(out, origins, defined, name)
     return Assembled(name=name, defines=key, text="\n".join(out) + "\n", origins=tuple(origins), files=tuple(seen))

@@ -15,8 +15,8 @@ into a VTK actor whose fragment shader ray-casts the spline:
   inside it;
 * VBO shift/scale is off, so ``vertexMC`` holds real model coordinates.
 
-Facts this relies on were measured on this machine (../shared/notes/vtk-headless-and-shader-injection.md)
-and are checked by tests/test_inject.py.
+Facts this relies on (VBO shift/scale, attribute limits, uniform declarations, front-face culling) were
+measured on Mesa llvmpipe and are checked by tests/test_inject.py.
 """
 
 from __future__ import annotations
@@ -205,11 +205,11 @@ class SplineActor:
         defines = dict(spec.defines)
         defines.update(style.defines())
         entry = "".join(f'#include "{f}"\n' for f in style.include_files())
-        entry += '#include "lib/shading.glsl"\n' + f'#include "{spec.entry}"\n'
-        # Effect functions must precede lib/shading.glsl which calls them; lib/raycast.glsl (SvHit)
+        entry += '#include "lib/core/shading.glsl"\n' + f'#include "{spec.entry}"\n'
+        # Effect functions must precede lib/core/shading.glsl which calls them; lib/core/raycast.glsl (SvHit)
         # must precede everything, so it goes first.
-        entry = '#include "lib/raycast.glsl"\n' + entry
-        self.assembled = assemble(entry, defines)
+        entry = '#include "lib/core/raycast.glsl"\n' + entry
+        self.assembled = assemble(entry, defines, extra_roots=tuple(spec.glsl_roots))
 
         poly = vtkPolyData()
         mapper = vtkOpenGLPolyDataMapper()

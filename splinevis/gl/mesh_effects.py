@@ -15,7 +15,7 @@ from vtkmodules.vtkCommonCore import VTK_OBJECT
 from .assembler import assemble
 from .inject import _set_uniform
 
-__all__ = ["add_mesh_with_reflection_lines"]
+__all__ = ["add_mesh_with_reflection_lines", "add_mesh_with_effects", "MESH_EFFECTS"]
 
 _VS_DEC = """//VTK::Normal::Dec
 out vec3 svMeshPosMC;
@@ -34,7 +34,7 @@ _FS_LIGHT = """//VTK::Light::Impl
   {
     vec3 sv_rd = normalize(svMeshPosMC - sv_eye_mc);
     vec3 sv_n = normalize(svMeshNormalMC);
-    if (dot(sv_n, sv_rd) > 0.0) sv_n = -sv_n;  // two-sided, as lib/shading.glsl
+    if (dot(sv_n, sv_rd) > 0.0) sv_n = -sv_n;  // two-sided, as lib/core/shading.glsl
     fragOutput0.rgb *= sv_reflection_lines(reflect(sv_rd, sv_n));
   }
 """
@@ -90,3 +90,28 @@ def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", 
     actor._sv_update = update  # keep the callback alive with the actor
     plotter.add_actor(actor, reset_camera=True)
     return actor
+
+
+#: Style effects a mesh made by a ``passes`` or ``mesh`` program can show today.
+MESH_EFFECTS = frozenset({"lights", "reflection_lines", "transparency"})
+
+
+def add_mesh_with_effects(plotter, mesh, style, *, name=None):
+    """Draw the dataset a ``passes`` or ``mesh`` program made (:mod:`splinevis.gl.contract`) with the scene's
+    :class:`~splinevis.Style`: colour, lighting weights and opacity through VTK, reflection lines through the
+    same GLSL file as the ray-cast programs (:func:`add_mesh_with_reflection_lines`).
+
+    Effects a mesh cannot show yet (textures, environment maps, isophotes, output modes) raise a
+    ``ValueError`` naming them, instead of being dropped silently.
+    """
+    unsupported = sorted(set(style.effect_set()) - MESH_EFFECTS)
+    if unsupported:
+        raise ValueError(f"a mesh-drawing program cannot show the effects {', '.join(unsupported)} yet; it shows "
+                         f"{', '.join(sorted(MESH_EFFECTS))}. Remove them from the Style.")
+    if style.reflection_lines:
+        actor = add_mesh_with_reflection_lines(plotter, mesh, int(style.reflection_lines), color=style.color,
+                                               ambient=style.ambient, diffuse=style.diffuse)
+        actor.GetProperty().SetOpacity(float(style.opacity))
+        return actor
+    return plotter.add_mesh(mesh, color=style.color, smooth_shading=True, ambient=style.ambient,
+                            diffuse=style.diffuse, opacity=float(style.opacity), lighting=style.lights > 0, name=name)

@@ -40,6 +40,9 @@ class ProgramSpec:
         cube to float32 precision whatever the volume's size.
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    glsl_roots : tuple of Path, optional
+        Folders searched for GLSL files before the shipped ``glsl/`` (a family outside the package keeps its
+        program file there; ``entry`` is then relative to such a folder).
     offset : (3,) float64, optional
         World position of the model frame's origin. Model coordinates (``points``, everything the
         shader sees) are world minus ``offset``; VTK composes the translation in double precision, so
@@ -57,3 +60,4 @@ class ProgramSpec:
     varyings: dict = field(default_factory=dict)
     frame_uniforms: Callable | None = None
     offset: tuple = (0.0, 0.0, 0.0)
+    glsl_roots: tuple = ()

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._validation import as_float64_array, check_choice
 from ..bb import simplex as _simplex
+from ..hierarchy.pyramid import MinMaxPyramid
 
 __all__ = ["TerrainSpline", "cell_barycentric"]
 
@@ -128,23 +129,13 @@ class TerrainSpline:
         x0, x1, y0, y1 = self.extent
         return np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1), self.z_ref])
 
-    def minmax_pyramid(self) -> list:
-        """Per level L a (ceil(ncy/2^L), ceil(ncx/2^L), 2) array of (min, max) coefficient bounds of the
-        blocks of 2^L x 2^L cells; level 0 = cells. The last level is a single block."""
+    @property
+    def hierarchy(self) -> MinMaxPyramid:
+        """The min/max quadtree of the coefficients: level 0 bounds each cell's 30 coefficients, level L the
+        blocks of 2^L x 2^L cells; the top level is a single block (built on first use)."""
         if self._pyramid is None:
             c = self._c.reshape(self._c.shape[0], self._c.shape[1], 30)
-            lvl = np.stack([c.min(axis=-1), c.max(axis=-1)], axis=-1)
-            levels = [lvl]
-            while lvl.shape[0] > 1 or lvl.shape[1] > 1:
-                ny, nx = lvl.shape[:2]
-                py, px = ny % 2, nx % 2
-                lo = np.pad(lvl[..., 0], ((0, py), (0, px)), constant_values=np.inf)
-                hi = np.pad(lvl[..., 1], ((0, py), (0, px)), constant_values=-np.inf)
-                lo = lo.reshape(lo.shape[0] // 2, 2, lo.shape[1] // 2, 2).min(axis=(1, 3))
-                hi = hi.reshape(hi.shape[0] // 2, 2, hi.shape[1] // 2, 2).max(axis=(1, 3))
-                lvl = np.stack([lo, hi], axis=-1)
-                levels.append(lvl)
-            self._pyramid = levels
+            self._pyramid = MinMaxPyramid(c.min(axis=-1), c.max(axis=-1))
         return self._pyramid
 
     # -- evaluation -----------------------------------------------------------------------------------

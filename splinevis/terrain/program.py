@@ -1,77 +1,85 @@
-"""The GPU program of a TerrainSpline: textures (coefficients, min/max hierarchy) and uniforms."""
+"""The terrain program: a ray cast through a min/max quadtree on one box proxy (glsl/programs/terrain.glsl).
+
+Declares :data:`PROGRAM` for the registry: the GPU spec (coefficient and hierarchy tables, uniforms), the
+float64 twin (:func:`splinevis.terrain.raycast.raycast_terrain`), the derived depth bound and the hard cases
+(:mod:`splinevis.terrain.hard_cases`).
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._validation import check_choice, check_degree
+from .._validation import check_degree
+from ..bb.root_options import check_root_method, root_defines
+from ..gl.contract import SplineProgram
+from ..gl.error_bounds import model_frame_matrix, ray_depth_error_bound
+from ..gl.proxies import boxes, pack_rgba32f
 from ..gl.spec import ProgramSpec
 from .model import TerrainSpline
 
-__all__ = ["terrain_program", "MAX_TEXTURE_WIDTH"]
+__all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "terrain_depth_bound", "PROGRAM"]
 
-#: GL_MAX_TEXTURE_SIZE of llvmpipe (and most GPUs); the coefficient table is 8 texels per cell wide.
-MAX_TEXTURE_WIDTH = 16384
-
-
-def _box(lo, hi):
-    x = np.array([[lo[0], lo[1], lo[2]], [hi[0], lo[1], lo[2]], [hi[0], hi[1], lo[2]], [lo[0], hi[1], lo[2]],
-                  [lo[0], lo[1], hi[2]], [hi[0], lo[1], hi[2]], [hi[0], hi[1], hi[2]], [lo[0], hi[1], hi[2]]])
-    tris = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-                     [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
-    return x, tris
+ROOTS = ("bracketed", "paper")
+#: Levels the shader's hierarchy uniforms hold.
+MAX_LEVELS = 16
 
 
 def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
-    """(ncy, 8 ncx, 4) float32: per cell 8 RGBA texels, T0's 15 then T1's 15 coefficients, 2 zeros."""
+    """Table texture of the coefficients: 8 texels per cell, cells row after row (cell (i, j) is number
+    ``j ncx + i``), T0's 15 then T1's 15 coefficients, 2 zeros (:func:`splinevis.gl.proxies.pack_rgba32f`)."""
     ncy, ncx = terrain.shape
     flat = np.zeros((ncy, ncx, 32), dtype=np.float32)
     flat[..., :30] = terrain.coefficients.reshape(ncy, ncx, 30)
-    return flat.reshape(ncy, ncx * 8, 4)
+    return pack_rgba32f(flat, name="terrain coefficient table")
 
 
-def minmax_atlas(terrain: TerrainSpline):
-    """(ncy, W, 4) float32 atlas of the hierarchy (level L at columns offsets[L]...), and the offsets."""
-    levels = terrain.minmax_pyramid()
-    widths = [lv.shape[1] for lv in levels]
-    offsets = np.concatenate([[0], np.cumsum(widths)[:-1]])
-    ncy = levels[0].shape[0]
-    atlas = np.zeros((ncy, int(sum(widths)), 4), dtype=np.float32)
-    for off, lv in zip(offsets, levels):
-        # Round bounds outward to float32 so the stored box still encloses the float64 coefficients.
-        lo = np.nextafter(lv[..., 0].astype(np.float32), np.float32(-np.inf))
-        hi = np.nextafter(lv[..., 1].astype(np.float32), np.float32(np.inf))
-        atlas[: lv.shape[0], off: off + lv.shape[1], 0] = lo
-        atlas[: lv.shape[0], off: off + lv.shape[1], 1] = hi
-    return atlas, offsets
+def hierarchy_table(terrain: TerrainSpline):
+    """Table texture of the min/max quadtree, level after level (one texel per block, .rg = (min, max),
+    rounded outward to float32 so each stored range still encloses the float64 coefficients), and the
+    texel offset and width (blocks per row) of each level."""
+    levels = terrain.hierarchy.levels
+    widths = np.array([lo.shape[1] for lo, _ in levels])
+    sizes = np.array([lo.size for lo, _ in levels])
+    offsets = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    texels = np.zeros((int(sizes.sum()), 4), dtype=np.float32)
+    for off, (lo, hi) in zip(offsets, levels):
+        texels[off: off + lo.size, 0] = np.nextafter(lo.astype(np.float32), np.float32(-np.inf)).ravel()
+        texels[off: off + lo.size, 1] = np.nextafter(hi.astype(np.float32), np.float32(np.inf)).ravel()
+    return pack_rgba32f(texels, name="terrain hierarchy table"), offsets, widths
 
 
-def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_steps: int | None = None,
+def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: int = 8, max_steps: int | None = None,
                     hierarchy: bool | int = True, roots: str = "bracketed") -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
-    ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (paper 000's
-    Newton from four secure starting points, compiled in with ``SV_ROOTS_PAPER_NEWTON``).
+    ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
+    secure starting points [Reis2008, sec. VI]); names as in :mod:`splinevis.bb.root_options`.
     ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
-    int caps the top level (what the benchmarks use to measure the hierarchy's effect).
+    int caps the top level (what the benchmarks use to measure the hierarchy's effect). ``style`` decides
+    nothing here.
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from splinevis.terrain import TerrainSpline
+    >>> t = TerrainSpline.from_heights(np.zeros((5, 9)), "C2")
+    >>> spec = terrain_program(t, hierarchy=False)
+    >>> spec.uniforms["sv_top_level"], spec.textures["sv_terrain_coef"].shape
+    (0, (1, 8192, 4))
     """
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
-    check_choice(roots, "roots", {"bracketed", "paper"})
+    check_root_method(roots, ROOTS, degree=4)
     ncy, ncx = terrain.shape
-    if 8 * ncx > MAX_TEXTURE_WIDTH or ncy > MAX_TEXTURE_WIDTH:
-        raise ValueError(
-            f"terrain of {ncx}x{ncy} cells exceeds the coefficient texture limit ({MAX_TEXTURE_WIDTH // 8} cells in x, "
-            f"{MAX_TEXTURE_WIDTH} in y); split it into tiles."
-        )
-    levels = terrain.minmax_pyramid()
-    if len(levels) > 16:
-        raise ValueError(f"terrain needs {len(levels)} hierarchy levels; at most 16 are supported.")
-    atlas, offsets = minmax_atlas(terrain)
+    levels = terrain.hierarchy.levels
+    if len(levels) > MAX_LEVELS:
+        raise ValueError(f"terrain of {ncx}x{ncy} cells needs {len(levels)} hierarchy levels; at most {MAX_LEVELS} "
+                         "are supported: split it into tiles.")
+    table, offsets, widths = hierarchy_table(terrain)
     if hierarchy is True:
         top = len(levels) - 1
     elif hierarchy is False:
@@ -82,21 +90,21 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
     x0, x1, y0, y1 = terrain.extent
     cmin, cmax = float(terrain.coefficients.min()), float(terrain.coefficients.max())
     pad = 1e-6 * max(1.0, cmax - cmin)
-    lo = np.array([x0 - off[0], y0 - off[1], cmin - pad])
-    hi = np.array([x1 - off[0], y1 - off[1], cmax + pad])
-    points, triangles = _box(lo, hi)
+    points, triangles = boxes([x0 - off[0], y0 - off[1], cmin - pad], [x1 - off[0], y1 - off[1], cmax + pad])
     sx, sy = terrain.cell_spacing
-    level_offsets = np.zeros(16)
+    level_offsets, level_widths = np.zeros(MAX_LEVELS), np.zeros(MAX_LEVELS)
     level_offsets[: len(offsets)] = offsets
+    level_widths[: len(widths)] = widths
     return ProgramSpec(
         name="terrain",
         entry="programs/terrain.glsl",
         points=points,
         triangles=triangles,
         offset=tuple(off),
-        defines={"SV_ROOTS_PAPER_NEWTON": roots == "paper"},
+        defines=root_defines(roots),
         uniforms={
             "sv_level_offset[]": level_offsets,
+            "sv_level_width[]": level_widths,
             "sv_top_level": top,
             "sv_ncells": (float(ncx), float(ncy)),
             "sv_index_scale": (1.0 / sx, 1.0 / sy),
@@ -108,5 +116,52 @@ def terrain_program(terrain: TerrainSpline, *, newton_iterations: int = 8, max_s
             "sv_scalar_offset": float(terrain.z_ref),
             "sv_scalar_range": terrain.zrange,
         },
-        textures={"sv_terrain_coef": coefficient_table(terrain), "sv_terrain_minmax": atlas},
+        textures={"sv_terrain_coef": coefficient_table(terrain), "sv_terrain_minmax": table},
     )
+
+
+def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t) -> np.ndarray:
+    """Derived bound on |GPU - float64| window depth at hits ``origins + t directions`` (world): the shader
+    works in the model frame (world - offset) and in index coordinates, so the rounded coordinates are
+    bounded by the terrain's extent (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`)."""
+    off = terrain.offset
+    o_mc = np.asarray(origins) - off
+    p = o_mc + np.asarray(t)[..., None] * np.asarray(directions)
+    x0, x1, y0, y1 = terrain.extent
+    coord = np.broadcast_to(np.array([x1 - x0, y1 - y0]), p[..., :2].shape)
+    return ray_depth_error_bound(lambda q: terrain.gradient(q[..., 0] + off[0], q[..., 1] + off[1]),
+                                 float(np.abs(terrain.coefficients).max()), model_frame_matrix(matrix, off),
+                                 o_mc, directions, t, coord, proxy_size=float(max(x1 - x0, y1 - y0, np.ptp(terrain.zrange))))
+
+
+def _reference(terrain, origins, directions, tmin=0.0, *, method="reference", iterations=8):
+    from .raycast import raycast_terrain
+
+    return raycast_terrain(terrain, origins, directions, tmin, method=method, iterations=iterations)
+
+
+def _model_from(heights, scheme: str = "C1", **read_options) -> TerrainSpline:
+    """A TerrainSpline from anything :func:`splinevis.io.read_heights` reads, or a HeightGrid."""
+    return TerrainSpline.from_heights(heights, scheme, **read_options)
+
+
+def _hard_cases():
+    from .hard_cases import hard_cases
+
+    return hard_cases()
+
+
+PROGRAM = SplineProgram(
+    name="terrain",
+    kind="raycast",
+    model_type=TerrainSpline,
+    build=terrain_program,
+    reference=_reference,
+    depth_bound=terrain_depth_bound,
+    hard_cases=_hard_cases,
+    model_from=_model_from,
+    root_methods=ROOTS,
+    newton_iterations=8,
+    options=("max_steps", "hierarchy", "roots"),
+    description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree",
+)

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._validation import as_float64_array, check_choice
-from ..analytic.patch import RayHits
 from ..bb.ray import graph_patch_first_hit
+from ..gl.contract import RayHits
 from .model import TerrainSpline, cell_barycentric
 
 __all__ = ["raycast_terrain", "first_hit_in_cell"]
@@ -47,9 +47,10 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     origins, directions : (…, 3) array_like
     tmin : float
         Smallest admissible ray parameter.
-    method : {"reference", "gpu"}
-        Root finder on each candidate segment: robust all-roots reference, or the shader's bracketed
-        Newton (float64 twin).
+    method : {"reference", "bracketed", "paper"}
+        Root finder on each candidate segment: the robust all-roots reference, or the shader's methods in
+        float64: bracketed Newton on convex pieces, or Newton from four secure starting points
+        [Reis2008, sec. VI].
 
     Returns
     -------
@@ -58,7 +59,7 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     """
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")
-    check_choice(method, "method", {"reference", "gpu"})
+    check_choice(method, "method", {"reference", "bracketed", "paper"})
     o = as_float64_array(origins, "origins", shape_tail=(3,))
     d = as_float64_array(directions, "directions", shape_tail=(3,))
     o, d = np.broadcast_arrays(o, d)
@@ -93,7 +94,7 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     cj = np.clip(np.floor(vv).astype(np.int64), 0, ncy - 1)
     step_i = np.where(dU > 0, 1, -1)
     step_j = np.where(dV > 0, 1, -1)
-    pyr = terrain.minmax_pyramid()[0]
+    cell_lo, cell_hi = terrain.hierarchy.levels[0]
     steps = max_steps if max_steps is not None else 2 * (ncx + ncy) + 4
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(steps):
@@ -109,7 +110,7 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
             tb = np.minimum(np.minimum(txu, txv), t1[idx])
             za, zb = Z0[idx] + ta * dZ[idx], Z0[idx] + tb * dZ[idx]
             rlo, rhi = np.minimum(za, zb), np.maximum(za, zb)
-            overlap = (rhi >= pyr[j, i, 0]) & (rlo <= pyr[j, i, 1])
+            overlap = (rhi >= cell_lo[j, i]) & (rlo <= cell_hi[j, i])
             if overlap.any():
                 k = idx[overlap]
                 ii, jj = ci[k], cj[k]

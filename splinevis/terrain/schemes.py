@@ -1,8 +1,8 @@
 """Quartic spline terrains on the type-1 triangulation, built from a uniform grid of heights.
 
 Every scheme here sets the 15 quartic Bernstein-Bezier (BB) coefficients of each triangle directly as a
-fixed linear combination of nearby heights (a *quasi-interpolant*, eq. (4) of the terrain paper,
-``/work/shared/papers/000_7d449fa3247defe5.txt``, section IV). Schemes:
+fixed linear combination of nearby heights (a *quasi-interpolant*, eq. (4) of [Reis2008], section IV).
+Schemes:
 
 ==========  =====================  ==========  ===========  =============================================
 scheme      spline cell            smoothness  reproduces   data stencil per cell (offsets from its corner)
@@ -31,24 +31,34 @@ Conventions
   along y over the padded rows). The rule is exact for cubics in each variable, so padding keeps the
   schemes' polynomial reproduction up to the boundary. It needs 4 heights along each axis.
 
-Engine
-------
-Every scheme is linear in ``z`` and translation invariant, so one engine serves all of them: a rectangular
-window of the (padded) grid around each cell, flattened to ``S`` values, times a weight matrix ``W`` of
-shape ``(S, 30)`` (15 coefficients of T0, then 15 of T1), done as a matrix product over sliding windows
-(:func:`numpy.lib.stride_tricks.sliding_window_view`) in chunks of rows.
+
+Modules
+-------
+This module defines the schemes and the public interface. The stencil engine that applies a scheme's
+weights to all cells, with the cubic padding, is :mod:`splinevis.terrain.engine`; the quartic BB tables of
+a cell and the smoothness conditions between cells are :mod:`splinevis.terrain.cell`; the derivation of
+the C1 weights is :mod:`splinevis.terrain.c1_scheme`; the box-spline C2 schemes are
+:mod:`splinevis.terrain.box_spline`.
+
+References
+----------
+.. [Reis2008] Reis et al. 2008, quartic terrain splines.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from math import factorial
 
 import numpy as np
 
 from .._validation import as_float64_array, check_choice
 from ..bb import simplex as _bb
+from .box_spline import _c2, _c2_cubic
+# C1_STENCIL, c1_system, _c1_solution and _pad_cubic are re-exported: the package and the tests read them here
+from .c1_scheme import C1_STENCIL as C1_STENCIL, _c1, _c1_solution as _c1_solution, c1_system as c1_system
+from .cell import _DEG, _DLAM, _MI, _TRI, _collocation_inverse
+from .engine import _apply, _check_height_grid, _offsets, _pad_cubic as _pad_cubic, _Stencil
 
 __all__ = [
     "SCHEMES",
@@ -62,14 +72,6 @@ __all__ = [
 
 #: Names accepted by :func:`terrain_coefficients`.
 SCHEMES = ("linear", "C0", "C1", "C2", "C2-cubic")
-
-_DEG = 4
-_MI = _bb.multi_indices(_DEG, 2)                      # (15, 3), lexicographic descending
-_IDX = {tuple(int(v) for v in a): q for q, a in enumerate(_MI)}
-#: Triangle vertices in cell units, relative to the cell's lower-left corner.
-_TRI = (np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)]), np.array([(0.0, 0.0), (1.0, 1.0), (0.0, 1.0)]))
-# d(lambda_k)/dx and d(lambda_k)/dy on T0 (lam = (1-x, x-y, y)) and T1 (lam = (1-y, x, y-x)).
-_DLAM = (np.array([[-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]]), np.array([[0.0, 1.0, -1.0], [-1.0, 0.0, 1.0]]))
 
 _SMOOTHNESS = {"linear": 0, "C0": 0, "C1": 1, "C2": 2, "C2-cubic": 2}
 _REPRODUCES = {"linear": 1, "C0": 4, "C1": 3, "C2": 1, "C2-cubic": 3}
@@ -107,98 +109,13 @@ class TerrainInfo:
     data_shape: tuple
 
 
-@dataclass(frozen=True)
-class _Stencil:
-    x0: int      # window's first data offset (x) relative to the cell corner (in data indices)
-    y0: int
-    kw: int      # window width/height in data points
-    kh: int
-    step: int    # data points per cell (4 for C0)
-    W: np.ndarray  # (kh * kw, 30); row a * kw + b <-> offset (x0 + b, y0 + a)
-
-    def pads(self):
-        """(left, right, bottom, top) padding the window needs beyond the grid."""
-        lo_x, lo_y = max(0, -self.x0), max(0, -self.y0)
-        hi_x = max(0, self.x0 + self.kw - 1 - self.step)
-        hi_y = max(0, self.y0 + self.kh - 1 - self.step)
-        return lo_x, hi_x, lo_y, hi_y
-
-
-# ----------------------------------------------------------------------------------------------------
-# BB helpers (exact tables, no validation)
-# ----------------------------------------------------------------------------------------------------
-
-def _bern(alpha, lam):
-    return factorial(_DEG) / np.prod([factorial(int(a)) for a in alpha]) * np.prod(np.asarray(lam, float) ** alpha)
-
-
-@functools.lru_cache(maxsize=None)
-def _collocation_inverse():
-    """Inverse of the 15x15 matrix B[p, q] = B^4_q(domain point p): BB coefficients = Binv @ values."""
-    B = np.array([[_bern(a, b / _DEG) for a in _MI] for b in _MI])
-    Binv = np.linalg.inv(B)
-    Binv.setflags(write=False)
-    return Binv
-
-
-def _domain_points(t):
-    """(15, 2) domain points of triangle Tt in cell units."""
-    return _MI @ _TRI[t] / _DEG
-
-
-def _monomial_bb(a, b, t):
-    """Quartic BB coefficients of x^a y^b (a + b <= 4) on triangle Tt of the cell at the origin."""
-    p = _domain_points(t)
-    return _collocation_inverse() @ (p[:, 0] ** a * p[:, 1] ** b)
-
-
-def _edge_conditions(r):
-    """C^0..C^r conditions between the triangles of neighbouring cells, as identities between coefficients.
-
-    Returns a list of relations; each relation is a list of ``(cell_shift, t, q, weight)`` with
-    ``sum weight * coef[cell + cell_shift, t, q] == 0`` required for every cell. The three pairs (T0, T1)
-    of the same cell (diagonal edge), T0 of a cell and T1 of the cell below (horizontal edge), T0 and T1
-    of the cell to the right (vertical edge) cover every interior edge. For triangles A, B sharing an edge,
-    with B's opposite vertex e having barycentric coordinates lam w.r.t. A, the C^rho condition is
-    ``c^B_beta = sum_{|g| = rho} B^rho_g(lam) c^A_{alpha0 + g}`` for every beta with beta_e = rho, where
-    alpha0 carries beta's exponents on the shared vertices (Farin, ch. 18; Lai & Schumaker, Thm. 2.28).
-    """
-    rels = []
-    pairs = [((0, 0), 0, (0, 0), 1), ((0, 0), 0, (0, -1), 1), ((0, 0), 0, (1, 0), 1)]
-    for dA, tA, dB, tB in pairs:
-        VA = _TRI[tA] + dA
-        VB = _TRI[tB] + dB
-        match = {k: m for k in range(3) for m in range(3) if np.array_equal(VA[k], VB[m])}
-        eB = next(m for m in range(3) if m not in match.values())
-        M = np.vstack([VA.T, np.ones(3)])
-        lam = np.linalg.solve(M, np.append(VB[eB], 1.0))
-        lam = np.round(lam * 8) / 8  # exact: the type-1 triangulation gives integer coordinates
-        for rho in range(r + 1):
-            for beta in _MI:
-                if beta[eB] != rho:
-                    continue
-                alpha0 = np.zeros(3, dtype=np.int64)
-                for k, m in match.items():
-                    alpha0[k] = beta[m]
-                terms = [(dB, tB, _IDX[tuple(int(v) for v in beta)], -1.0)]
-                for g in _bb.multi_indices(rho, 2):
-                    w = factorial(rho) / np.prod([factorial(int(v)) for v in g]) * np.prod(lam ** g)
-                    if w != 0.0:
-                        terms.append((dA, tA, _IDX[tuple(int(v) for v in alpha0 + g)], float(w)))
-                rels.append(terms)
-    return rels
-
-
 # ----------------------------------------------------------------------------------------------------
 # the schemes' weight matrices
 # ----------------------------------------------------------------------------------------------------
 
-def _offsets(x0, y0, kw, kh):
-    return [(x0 + b, y0 + a) for a in range(kh) for b in range(kw)]
-
-
 @functools.lru_cache(maxsize=None)
 def _linear():
+    """The linear scheme: the interpolant at the cell corners, degree-elevated to quartic."""
     offs = _offsets(0, 0, 2, 2)
     W = np.zeros((4, 30))
     for t in range(2):
@@ -210,6 +127,7 @@ def _linear():
 
 @functools.lru_cache(maxsize=None)
 def _c0():
+    """The C0 scheme: quartic interpolation at the 15 domain points of each triangle of a 4x4 cell."""
     offs = _offsets(0, 0, 5, 5)
     Binv = _collocation_inverse()
     W = np.zeros((25, 30))
@@ -218,136 +136,6 @@ def _c0():
         for p, (px, py) in enumerate(pts):
             W[offs.index((int(px), int(py))), t * 15:(t + 1) * 15] += Binv[:, p]
     return _Stencil(0, 0, 5, 5, 4, W)
-
-
-# 24 x the BB coefficients on T0 of the translates M(. - j) of the quartic box spline with directions
-# (1,0), (0,1), (1,1) each twice (from the notes; verified by tests: partition of unity, C2, M(0) = 1/2).
-_BOX_T0 = {
-    (-1, -1): (2, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0),
-    (-1, 0): (2, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0),
-    (0, -1): (2, 3, 1, 4, 1, 0, 3, 1, 0, 0, 2, 1, 0, 0, 0),
-    (0, 0): (12, 12, 12, 8, 10, 8, 4, 6, 6, 4, 2, 3, 4, 3, 2),
-    (0, 1): (2, 1, 3, 0, 1, 4, 0, 0, 1, 3, 0, 0, 0, 1, 2),
-    (1, -1): (0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 0),
-    (1, 0): (2, 4, 3, 8, 6, 4, 12, 10, 6, 3, 12, 12, 8, 4, 2),
-    (1, 1): (2, 3, 4, 4, 6, 8, 3, 6, 10, 12, 2, 4, 8, 12, 12),
-    (1, 2): (0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2),
-    (2, 0): (0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 1, 0, 0, 0),
-    (2, 1): (0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 3, 4, 3, 2),
-    (2, 2): (0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 2),
-}
-
-
-def _box_weights():
-    """{offset j: (30,) weights} of M(. - j) on T0 and T1 of the cell at the origin."""
-    swap_q = [_IDX[(int(a[0]), int(a[2]), int(a[1]))] for a in _MI]  # T1 (a,b,c) <- T0 (a,c,b)
-    out = {}
-    for (jx, jy), row in _BOX_T0.items():
-        out.setdefault((jx, jy), np.zeros(30))[:15] += np.array(row, float) / 24.0
-        # T1 is the mirror image of T0 under x <-> y (with vertices 1, 2 exchanged):
-        # coefficient (a,b,c) of M(. - j) on T1 = coefficient (a,c,b) of M(. - swap(j)) on T0.
-        out.setdefault((jy, jx), np.zeros(30))[15:] += np.array(row, float)[swap_q] / 24.0
-    return out
-
-
-@functools.lru_cache(maxsize=None)
-def _c2():
-    offs = _offsets(-1, -1, 4, 4)
-    W = np.zeros((16, 30))
-    for j, w in _box_weights().items():
-        W[offs.index(j)] += w
-    return _Stencil(-1, -1, 4, 4, 1, W)
-
-
-#: The cubic-exact prefilter of C2-cubic: c_j = 3/2 z_j - 1/12 (sum of z at the 6 mesh neighbours).
-_PREFILTER = {(0, 0): 1.5, **{n: -1.0 / 12.0 for n in [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1)]}}
-
-
-@functools.lru_cache(maxsize=None)
-def _c2_cubic():
-    offs = _offsets(-2, -2, 6, 6)
-    W = np.zeros((36, 30))
-    for j, w in _box_weights().items():
-        for n, p in _PREFILTER.items():
-            W[offs.index((j[0] + n[0], j[1] + n[1]))] += p * w
-    return _Stencil(-2, -2, 6, 6, 1, W)
-
-
-#: Data offsets of the C1 scheme (22 points; symmetric under x <-> y and under (x, y) -> (1-x, 1-y)):
-#: the 4x4 block [-1, 2]^2 without its corners (-1, 2), (2, -1), plus two points beyond each side.
-C1_STENCIL = tuple(sorted(
-    [(x, y) for x in range(-1, 3) for y in range(-1, 3) if (x, y) not in ((-1, 2), (2, -1))]
-    + [(-2, 0), (-2, 1), (3, 0), (3, 1), (0, -2), (1, -2), (0, 3), (1, 3)], key=lambda o: (o[1], o[0])))
-
-
-def c1_system(offsets=C1_STENCIL, *, smoothness=1, reproduce=3):
-    """The linear system whose solution is the C1 scheme's weights (see ``docs/terrain-schemes.md``).
-
-    Unknowns ``w[s, tq]`` (``s`` over ``offsets``, ``tq = 15 t + q`` over the 30 coefficients of a cell),
-    flattened as ``s * 30 + tq``. Rows: (i) for every C^0..C^smoothness edge condition of
-    :func:`_edge_conditions` and every data offset ``o``, the weight of ``z(cell + o)`` in the condition
-    must vanish (the condition holds for all data; a neighbour cell's weights are the stencil shifted by
-    the cell offset); (ii) for every monomial ``x^a y^b`` with ``a + b <= reproduce`` and every coefficient,
-    the weights applied to the monomial's samples give its BB coefficient (its blossom at the domain
-    point). Returns ``(A, rhs, n_smooth_rows)``.
-    """
-    oi = {o: k for k, o in enumerate(offsets)}
-    S = len(offsets)
-    rows, rhs = [], []
-    for terms in _edge_conditions(smoothness):
-        outs = sorted({(o[0] + d[0], o[1] + d[1]) for d, _, _, _ in terms for o in offsets})
-        for u in outs:
-            row = {}
-            for d, t, q, w in terms:
-                s = oi.get((u[0] - d[0], u[1] - d[1]))
-                if s is not None:
-                    key = s * 30 + t * 15 + q
-                    row[key] = row.get(key, 0.0) + w
-            row = {k: v for k, v in row.items() if v != 0.0}
-            if row:
-                rows.append(row)
-                rhs.append(0.0)
-    n_smooth = len(rows)
-    off = np.array(offsets, float)
-    for a in range(reproduce + 1):
-        for b in range(reproduce + 1 - a):
-            samples = off[:, 0] ** a * off[:, 1] ** b
-            for t in range(2):
-                bb = _monomial_bb(a, b, t)
-                for q in range(15):
-                    rows.append({s * 30 + t * 15 + q: samples[s] for s in range(S) if samples[s] != 0.0})
-                    rhs.append(bb[q])
-    A = np.zeros((len(rows), S * 30))
-    for k, row in enumerate(rows):
-        for c, v in row.items():
-            A[k, c] = v
-    return A, np.array(rhs), n_smooth
-
-
-@functools.lru_cache(maxsize=None)
-def _c1_solution():
-    """Least-norm weights of the C1 system (unique, hence symmetric) and the system's diagnostics."""
-    A, rhs, n_smooth = c1_system()
-    x, _, rank, _ = np.linalg.lstsq(A, rhs, rcond=None)
-    resid = A @ x - rhs
-    W = x.reshape(len(C1_STENCIL), 30)
-    diag = {"rows": A.shape[0], "unknowns": A.shape[1], "rank": int(rank),
-            "smoothness_residual": float(np.abs(resid[:n_smooth]).max()),
-            "exactness_residual": float(np.abs(resid[n_smooth:]).max())}
-    if max(diag["smoothness_residual"], diag["exactness_residual"]) > 1e-12:  # pragma: no cover
-        raise RuntimeError(f"C1 weight system is inconsistent: {diag}")
-    W.setflags(write=False)
-    return W, diag
-
-
-@functools.lru_cache(maxsize=None)
-def _c1():
-    Wc, _ = _c1_solution()
-    offs = _offsets(-2, -2, 6, 6)
-    W = np.zeros((36, 30))
-    for s, o in enumerate(C1_STENCIL):
-        W[offs.index(o)] = Wc[s]
-    return _Stencil(-2, -2, 6, 6, 1, W)
 
 
 _BUILDERS = {"linear": _linear, "C0": _c0, "C1": _c1, "C2": _c2, "C2-cubic": _c2_cubic}
@@ -369,20 +157,13 @@ def scheme_stencil(scheme):
 
 
 # ----------------------------------------------------------------------------------------------------
-# input checks, padding, engine
+# input checks, coefficients, resampling
 # ----------------------------------------------------------------------------------------------------
 
 def _check_heights(z, scheme):
+    """``z`` as a finite 2-D float64 grid of at least the scheme's minimum size (sizes 4k + 1 for C0)."""
     check_choice(scheme, "scheme", SCHEMES)
-    z = as_float64_array(z, "z (heights)", finite=False)
-    if z.ndim != 2:
-        raise ValueError(f"z (heights) must be a 2-D array of shape (ny, nx) with z[j, i] at index point (i, j); "
-                         f"got {z.ndim}-D shape {z.shape}.")
-    bad = ~np.isfinite(z)
-    if bad.any():
-        r, c = (int(v) for v in np.argwhere(bad)[0])
-        raise ValueError(f"z (heights) must be finite; found {int(bad.sum())} non-finite value(s), the first, "
-                         f"{float(z[r, c])!r}, at row {r}, column {c} (z[{r}, {c}], index point x={c}, y={r}).")
+    z = _check_height_grid(z)
     ny, nx = z.shape
     m = _MIN_SIZE[scheme]
     if ny < m or nx < m:
@@ -397,79 +178,8 @@ def _check_heights(z, scheme):
 
 
 def _next_c0(n):
+    """The smallest size ``4k + 1 >= n``."""
     return 4 * -(-(n - 1) // 4) + 1
-
-
-def _pad_cubic(z, lo_x, hi_x, lo_y, hi_y):
-    """Pad by cubic extrapolation f[-1] = 4 f[0] - 6 f[1] + 4 f[2] - f[3] (x first, then y)."""
-    ny, nx = z.shape
-    out = np.empty((ny + lo_y + hi_y, nx + lo_x + hi_x))
-    out[lo_y:lo_y + ny, lo_x:lo_x + nx] = z
-    rows = slice(lo_y, lo_y + ny)
-    for k in range(lo_x - 1, -1, -1):
-        c = out[rows, k + 1:k + 5]
-        out[rows, k] = 4 * c[:, 0] - 6 * c[:, 1] + 4 * c[:, 2] - c[:, 3]
-    for k in range(lo_x + nx, lo_x + nx + hi_x):
-        c = out[rows, k - 4:k]
-        out[rows, k] = 4 * c[:, 3] - 6 * c[:, 2] + 4 * c[:, 1] - c[:, 0]
-    for k in range(lo_y - 1, -1, -1):
-        c = out[k + 1:k + 5]
-        out[k] = 4 * c[0] - 6 * c[1] + 4 * c[2] - c[3]
-    for k in range(lo_y + ny, lo_y + ny + hi_y):
-        c = out[k - 4:k]
-        out[k] = 4 * c[3] - 6 * c[2] + 4 * c[1] - c[0]
-    return out
-
-
-_CHUNK_CELLS = 1 << 13   # cells per gather (np.take) of the stencil values
-# OpenBLAS runs a GEMM on one thread when M * N * K <= 65536 * 4; larger skinny products (K = S <= 30,
-# N = 30) got *slower* with its threads on a loaded 2-core machine. So the products are kept below that
-# size and the two cores are used by two Python threads working on alternate row chunks instead.
-_GEMM_SINGLE = 65536 * 4
-_THREADS = 2
-
-
-def _apply(z, st: _Stencil):
-    """coef[j, i] = W^T (heights at the cell's stencil points), for all cells, in chunks of rows."""
-    lo_x, hi_x, lo_y, hi_y = st.pads()
-    zp = _pad_cubic(z, lo_x, hi_x, lo_y, hi_y) if (lo_x or hi_x or lo_y or hi_y) else np.ascontiguousarray(z)
-    ny, nx = z.shape
-    ncx, ncy = (nx - 1) // st.step, (ny - 1) // st.step
-    # Only the stencil points with a nonzero weight are gathered: a sliding window of the padded grid,
-    # read through flat indices: cell (i, j)'s corner is (step i + lo_x, step j + lo_y) in the padded grid,
-    # its window starts at corner + (x0, y0) (never negative: lo_x >= -x0, lo_y >= -y0).
-    keep = np.flatnonzero(np.any(st.W != 0.0, axis=1))
-    offs = np.array(_offsets(st.x0, st.y0, st.kw, st.kh))[keep] - (st.x0, st.y0)  # >= 0: window-relative
-    W = np.ascontiguousarray(st.W[keep])
-    S = len(keep)
-    wp = zp.shape[1]
-    zflat = zp.reshape(-1)
-    rows = max(1, min(ncy, _CHUNK_CELLS // max(ncx, 1)))
-    jj, ii = np.meshgrid(np.arange(rows), np.arange(ncx), indexing="ij")
-    rel = ((st.step * jj * wp + st.step * ii).reshape(-1, 1) + (offs[:, 1] * wp + offs[:, 0])[None, :])
-    out = np.empty((ncy, ncx, 2, 15))
-    flat = out.reshape(ncy * ncx, 30)
-    sub = max(16, _GEMM_SINGLE // (30 * S))
-
-    def work(r0):
-        r1 = min(ncy, r0 + rows)
-        m = (r1 - r0) * ncx
-        base = (st.step * r0 + lo_y + st.y0) * wp + lo_x + st.x0  # window start of cell (0, r0)
-        blk = np.take(zflat[base:], rel[:m])
-        dst = flat[r0 * ncx:r1 * ncx]
-        for k in range(0, m, sub):
-            np.matmul(blk[k:k + sub], W, out=dst[k:k + sub])
-
-    starts = range(0, ncy, rows)
-    if ncy * ncx >= 4 * _CHUNK_CELLS and _THREADS > 1:
-        from concurrent.futures import ThreadPoolExecutor
-
-        with ThreadPoolExecutor(_THREADS) as ex:
-            list(ex.map(work, starts))
-    else:
-        for r0 in starts:
-            work(r0)
-    return out
 
 
 def terrain_coefficients(z, scheme="C1"):
@@ -544,14 +254,7 @@ def resample_for_c0(z):
         ``(sx, sy)``: old index units per new index unit. Multiply new index coordinates (and the physical
         grid spacing) by it.
     """
-    z = as_float64_array(z, "z (heights)", finite=False)
-    if z.ndim != 2:
-        raise ValueError(f"z (heights) must be a 2-D array of shape (ny, nx); got {z.ndim}-D shape {z.shape}.")
-    bad = ~np.isfinite(z)
-    if bad.any():
-        r, c = (int(v) for v in np.argwhere(bad)[0])
-        raise ValueError(f"z (heights) must be finite; the first non-finite value, {float(z[r, c])!r}, is at "
-                         f"row {r}, column {c}.")
+    z = _check_height_grid(z)
     ny, nx = z.shape
     if ny < 4 or nx < 4:
         raise ValueError(f"resample_for_c0 needs at least 4x4 heights (for its cubic padding), got {ny}x{nx}.")

@@ -41,8 +41,9 @@ import itertools
 import numpy as np
 
 from ..bb import simplex as bb
-from .partition import NUM_TETS, _bary_mats, _inner_faces, _tets
-from .schemes import _BIG_ID, STENCIL, _lift, spline_coefficients
+from .domain import domain_index, domain_table, inner_face_rows
+from .partition import NUM_TETS, _inner_faces as _inner_faces, _tets  # _inner_faces re-exported for the tests
+from .stencil import STENCIL, _apply_point_weights, _check_volume, _lift
 
 __all__ = ["NUM_DOMAIN_POINTS", "domain_points", "determining_set", "inner_face_conditions", "derive_weights",
            "cubic_c1_spline"]
@@ -53,25 +54,14 @@ _SCALE = 6  # domain points of degree 3 on the partition are multiples of 1/6 (l
 _DENOM = 192  # the derived weights are multiples of 1/192
 
 
-@functools.lru_cache(maxsize=None)
 def _domain():
-    v = _tets()
-    mi = bb._multi_indices(3, 3)
-    keys: dict = {}
-    tmap = np.zeros((NUM_TETS, 20), dtype=np.int64)
-    for t in range(NUM_TETS):
-        for q, a in enumerate(mi):
-            k = tuple(int(x) for x in np.round(2 * (a @ v[t])))  # 6 * (a @ v) / 3
-            keys.setdefault(k, len(keys))
-            tmap[t, q] = keys[k]
-    pts = np.array(sorted(keys, key=keys.get), dtype=np.float64) / _SCALE
-    pts.setflags(write=False)
-    tmap.setflags(write=False)
-    return pts, tmap, keys
+    """``(points (175, 3), tet_map (24, 20), keys)`` of the cubic domain points (read-only tables)."""
+    return domain_table(3)
 
 
 def _idx(x):
-    return _domain()[2][tuple(int(v) for v in np.round(_SCALE * np.asarray(x)))]
+    """Index of the cubic domain point ``x`` (local coordinates)."""
+    return domain_index(3, x)
 
 
 def domain_points():
@@ -99,31 +89,11 @@ def determining_set() -> np.ndarray:
     return _determining().copy()
 
 
-@functools.lru_cache(maxsize=None)
-def _inner_rows():
-    v = _tets()
-    rows, pairs = [], []
-    for t, s, sh in _inner_faces():
-        e = [w for w in v[s] if not any(np.array_equal(w, z) for z in sh)][0]
-        lam = _bary_mats()[t][:, :3] @ e + _bary_mats()[t][:, 3]
-        for i1, i2 in itertools.combinations_with_replacement(range(3), 2):
-            b = sh[i1] + sh[i2]  # c_s(e, b1, b2) = sum_i lam_i c_t(v_i, b1, b2)  (blossom form)
-            r = np.zeros(NUM_DOMAIN_POINTS)
-            r[_idx((e + b) / 3)] += 1.0
-            for i in range(4):
-                r[_idx((v[t][i] + b) / 3)] -= lam[i]
-            rows.append(r)
-        pairs.append((t, s))
-    A = np.array(rows)
-    A.setflags(write=False)
-    return A, pairs
-
-
 def inner_face_conditions():
     """C1 conditions across the 36 inner faces: ``(A (216, 175), pairs)``, ``A @ c = 0`` for the
     coefficients ``c`` of a spline that is C1 inside the cube; rows ``6 m .. 6 m + 5`` belong to the face
     shared by tetrahedra ``pairs[m]``."""
-    A, pairs = _inner_rows()
+    A, pairs = inner_face_rows(3)
     return A.copy(), list(pairs)
 
 
@@ -217,7 +187,7 @@ def _poly_coefficients(f):
 
 @functools.lru_cache(maxsize=None)
 def _weights():
-    A, pairs = _inner_rows()
+    A, pairs = inner_face_rows(3)
     det = _determining()
     rest = np.setdiff1d(np.arange(NUM_DOMAIN_POINTS), det)
     Au, Ak = A[:, rest], A[:, det]
@@ -340,4 +310,4 @@ def derive_weights() -> dict:
 def cubic_c1_spline(volume) -> np.ndarray:
     """BB coefficients of the cubic C1 quasi-interpolant of ``volume``:
     ``spline_coefficients(volume, "cubic")``, shape ``(nz, ny, nx, 24, 20)``."""
-    return spline_coefficients(volume, "cubic")
+    return _apply_point_weights(_check_volume(volume), _weights()[0], _domain()[1])

@@ -1,7 +1,7 @@
 """VolumeSpline: a trivariate spline of volume data on the type-6 partition, in world coordinates.
 
 The model keeps only what does not depend on an isovalue: the padded data (float64), the per-cube
-coefficient bounds and their :class:`~splinevis.volume.octree.MinMaxOctree`. For an isovalue,
+coefficient bounds and their min-max octree (:class:`~splinevis.hierarchy.MinMaxPyramid` in 3-D). For an isovalue,
 :meth:`VolumeSpline.relevant` finds the cubes and tetrahedra whose BB coefficients straddle it (paper 003,
 sec. 4: octree branches with the isovalue in ``[fmin, fmax]``, then the convex-hull test per tetrahedron).
 
@@ -19,7 +19,7 @@ import numpy as np
 from ..bb import simplex as bb
 from ..io.volumes import VolumeGrid
 from . import schemes as _schemes
-from .octree import MinMaxOctree
+from ..hierarchy.pyramid import MinMaxPyramid
 from .partition import NUM_TETS, _bary_mats, _locate
 
 __all__ = ["VolumeSpline", "Relevant", "tet_weights", "SCHEME_DEGREE", "MIN_SAMPLES"]
@@ -246,10 +246,10 @@ class VolumeSpline:
         return self._distinct
 
     @property
-    def octree(self) -> MinMaxOctree:
+    def octree(self) -> MinMaxPyramid:
         """The min-max octree (built on first use; independent of the isovalue)."""
         if self._octree is None:
-            self._octree = MinMaxOctree(*self.cube_ranges())
+            self._octree = MinMaxPyramid(*self.cube_ranges())
         return self._octree
 
     def relevant(self, isovalue: float, *, chunk: int = 32768) -> Relevant:
@@ -261,7 +261,7 @@ class VolumeSpline:
         if not np.isfinite(iso):
             raise ValueError(f"isovalue must be a finite number, got {isovalue!r}.")
         t0 = time.perf_counter()
-        cand = self.octree.candidates(iso)
+        cand = self.octree.nodes(iso, 0)[:, ::-1]  # (i, j, k), in (k, j, i) order
         cubes, masks = [], []
         bits = (np.int64(1) << np.arange(NUM_TETS, dtype=np.int64))
         # The 24 m coefficients of a cube are few distinct combinations of its data (65 for the quadratic,

@@ -18,43 +18,45 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..bb import roots as R
+from .._validation import as_float64_array, check_choice
+from ..bb.root_options import first_root
 from ..bb import simplex as bb
 from .partition import NUM_TETS, _bary_mats
-from .program import Isosurface
+from ..gl.contract import RayHits
+from .isosurface import Isosurface
 
 __all__ = ["raycast_isosurface"]
 
 
-def _first_root(c, method, iterations):
-    if method == "reference":
-        return R.first_root_reference(c)
-    if method == "analytic":
-        return R.first_root_quadratic(c) if c.shape[-1] == 3 else R.first_root_cubic(c)
-    if method == "bracketed":
-        return R.first_root_bracketed(c, iterations)
-    return R.newton_three_starts(c, iterations)
-
-
-def raycast_isosurface(model: Isosurface, origins, directions, *, tmin=0.0, method: str = "reference",
-                       iterations: int = 6, margin: float = 1e-12):
+def raycast_isosurface(model: Isosurface, origins, directions, tmin=0.0, *, method: str = "reference",
+                       iterations: int = 6, margin: float = 1e-12) -> RayHits:
     """First hits of rays ``origins + t directions`` (world, t >= tmin) with the isosurface.
+
+    Parameters
+    ----------
+    model : Isosurface
+    origins, directions : (..., 3) array_like
+    tmin : float or (...) array_like
+    method : {"reference", "analytic", "bracketed", "paper"}
+        The robust reference, or a GPU root finder in float64 (:mod:`splinevis.bb.root_options`).
 
     Returns
     -------
-    t : (n,) float64, NaN where the ray misses.
-    normal : (n, 3) float64 world gradient of the spline at the hit (NaN on misses); unnormalised.
+    RayHits
+        ``t`` (NaN on a miss), hit points, and ``normals``: the world gradient of the spline at the hit
+        (unnormalised).
     """
     if not isinstance(model, Isosurface):
         raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")
-    if method not in {"reference", "analytic", "bracketed", "paper"}:
-        raise ValueError(f"method must be reference, analytic, bracketed or paper, got {method!r}.")
+    check_choice(method, "method", {"reference", "analytic", "bracketed", "paper"})
     spline = model.spline
-    o = np.atleast_2d(np.asarray(origins, dtype=np.float64))
-    d = np.atleast_2d(np.asarray(directions, dtype=np.float64))
+    o = as_float64_array(origins, "origins", shape_tail=(3,))
+    d = as_float64_array(directions, "directions", shape_tail=(3,))
     o, d = np.broadcast_arrays(o, d)
+    shape = o.shape[:-1]
+    o, d = o.reshape(-1, 3), d.reshape(-1, 3)
     n = len(o)
-    tmin = np.broadcast_to(np.asarray(tmin, dtype=np.float64), (n,)).copy()
+    tmin = np.broadcast_to(np.asarray(tmin, dtype=np.float64), shape).reshape(-1).copy()
     sp = spline.spacing
     P0 = (o - spline.origin) / sp  # index space; t unchanged
     D = d / sp
@@ -110,7 +112,8 @@ def raycast_isosurface(model: Isosurface, origins, directions, *, tmin=0.0, meth
         keep = ~finished
         idx = idx[keep]
         cells = new_cell[keep]
-    return t_hit, normal
+    t_hit = t_hit.reshape(shape)
+    return RayHits(t_hit, (o + t_hit.reshape(-1)[:, None] * d).reshape(shape + (3,)), normal.reshape(shape + (3,)))
 
 
 def _hit_in_cubes(spline, coef, masks, cell, P0, D, ta0, tb0, M, method, iterations, margin):
@@ -136,7 +139,7 @@ def _hit_in_cubes(spline, coef, masks, cell, P0, D, ta0, tb0, M, method, iterati
         la = lo[ok] + a[ok, None] * ld[ok]
         lb = lo[ok] + b[ok, None] * ld[ok]
         c = bb.restrict_to_segment(coef[rows, t], la, lb, d=3)
-        s = _first_root(c, method, iterations)
+        s = first_root(c, method, iterations)
         th = a[ok] + s * (b[ok] - a[ok])
         better = np.isfinite(th) & (th < best[rows])
         best[rows[better]] = th[better]

@@ -180,7 +180,7 @@ def _classify(c, x, ref):
 def compare_root_methods(cubics, iterations=(3, 5, 8), *, ref=None, masks: bool = False) -> dict:
     """Outcome counts of the float32 root finders on cubics, judged by the float64 reference.
 
-    Methods (float32 twins of ``glsl/lib/roots.glsl``; the coefficients are first rounded to float32, as
+    Methods (float32 twins of ``glsl/lib/core/roots.glsl``; the coefficients are first rounded to float32, as
     the GPU sees them, and the reference solves that same float32 polynomial in float64):
 
     * ``"analytic cubic"`` -- :func:`splinevis.bb.roots.first_root_cubic` (closed form + 1 polish step);

@@ -2,7 +2,9 @@
 al., CAGD 22 (2005); used on the GPU by Kalbe and Zeilfelder, paper 003), and the interface shared with
 the cubic C1 scheme (:mod:`splinevis.volume.cubic`) in the format the GPU program reads: ``STENCIL``,
 :func:`pad_volume`, :func:`tet_weights`, :func:`spline_coefficients`, :func:`cube_coefficients`,
-:func:`evaluate`, :func:`evaluate_volume`. See docs/volume-schemes.md.
+:func:`evaluate`, :func:`evaluate_volume`. See docs/volume-schemes.md. The stencil and the padding are
+:mod:`splinevis.volume.stencil`, the domain-point tables and inner C1 conditions of both degrees
+:mod:`splinevis.volume.domain`.
 
 Conventions
 -----------
@@ -48,7 +50,20 @@ import numpy as np
 
 from .._validation import as_float64_array
 from ..bb import simplex as bb
-from .partition import NUM_TETS, _bary_mats, _inner_faces, _locate, _tets
+from . import cubic as _cubic
+from .domain import domain_index, domain_table, inner_face_rows
+# _inner_faces, _check_volume and _pad are re-exported: other modules and the tests read them from here
+from .partition import NUM_TETS, _bary_mats, _inner_faces as _inner_faces, _locate, _tets
+from .stencil import (
+    _BIG_ID,
+    _S27,
+    STENCIL,
+    _apply_point_weights,
+    _check_volume as _check_volume,
+    _lift,
+    _pad as _pad,
+    pad_volume,
+)
 
 __all__ = ["domain_points", "edge_points", "inner_face_conditions", "derive_weights",
            "quadratic_super_spline", "evaluate", "NUM_DOMAIN_POINTS", "STENCIL", "SCHEMES", "pad_volume",
@@ -58,19 +73,9 @@ __all__ = ["domain_points", "edge_points", "inner_face_conditions", "derive_weig
 NUM_DOMAIN_POINTS = 65
 
 
-@functools.lru_cache(maxsize=None)
 def _domain():
-    v = _tets()
-    mi = bb._multi_indices(2, 3)
-    keys: dict = {}
-    tmap = np.zeros((NUM_TETS, 10), dtype=np.int64)
-    for t in range(NUM_TETS):
-        for q, a in enumerate(mi):
-            k = tuple(int(x) for x in np.round(2 * (a @ v[t])))  # 4 * domain point
-            keys.setdefault(k, len(keys))
-            tmap[t, q] = keys[k]
-    pts = np.array(sorted(keys, key=keys.get), dtype=np.float64) / 4.0
-    return pts, tmap, keys
+    """``(points (65, 3), tet_map (24, 10), keys)`` of the quadratic domain points (read-only tables)."""
+    return domain_table(2)
 
 
 def domain_points():
@@ -95,26 +100,16 @@ def _face_points():
 
 
 def _idx(x):
-    return _domain()[2][tuple(int(v) for v in np.round(4 * np.asarray(x)))]
+    """Index of the quadratic domain point ``x`` (local coordinates)."""
+    return domain_index(2, x)
 
 
 def inner_face_conditions():
     """C1 conditions across the 36 inner faces of the split: ``(A (108, 65), pairs)`` with ``A @ c = 0``
     for the 65 domain-point coefficients ``c`` of a spline that is C1 inside the cube; row ``3 m + r``
     belongs to the face shared by tetrahedra ``pairs[m]``."""
-    v = _tets()
-    rows, pairs = [], []
-    for t, s, sh in _inner_faces():
-        e = [w for w in v[s] if not any(np.array_equal(w, z) for z in sh)][0]
-        lam = _bary_mats()[t][:, :3] @ e + _bary_mats()[t][:, 3]
-        for b in sh:  # c_s((e + b)/2) = sum_i lam_i c_t((v_i + b)/2)   (blossom form of the C1 condition)
-            r = np.zeros(NUM_DOMAIN_POINTS)
-            r[_idx((e + b) / 2)] += 1.0
-            for i in range(4):
-                r[_idx((v[t][i] + b) / 2)] -= lam[i]
-            rows.append(r)
-        pairs.append((t, s))
-    return np.array(rows), pairs
+    A, pairs = inner_face_rows(2)
+    return A.copy(), list(pairs)
 
 
 def _face_conditions():
@@ -148,13 +143,6 @@ def _solve_block(A, known, unknown, name):
     return W
 
 
-#: Data offsets (x, y, z) of the 27-point stencil of a cube, z slowest, x fastest.
-STENCIL = np.array([(x, y, z) for z in (-1, 0, 1) for y in (-1, 0, 1) for x in (-1, 0, 1)], dtype=np.int64)
-_BIG = np.array([(x, y, z) for z in range(-2, 3) for y in range(-2, 3) for x in range(-2, 3)], dtype=np.int64)
-_BIG_ID = {tuple(int(v) for v in o): n for n, o in enumerate(_BIG)}
-_S27 = np.array([_BIG_ID[tuple(int(v) for v in o)] for o in STENCIL])
-
-
 def _edge_data_weights():
     """(20, 27) data weights of the edge coefficients (cube centred at the data point 0)."""
     pts = _domain()[0][edge_points()]
@@ -167,14 +155,6 @@ def _edge_data_weights():
         for o in itertools.product(*rng):
             E[m, sid[o]] += w
     return E
-
-
-def _lift(M27, shift):
-    """(..., 27) stencil weights of the cube at offset `shift` -> (..., 125) weights on offsets -2..2."""
-    out = np.zeros(M27.shape[:-1] + (125,))
-    for j, o in enumerate(STENCIL):
-        out[..., _BIG_ID[tuple(int(v) for v in o + shift)]] += M27[..., j]
-    return out
 
 
 def _snap(w):
@@ -319,58 +299,11 @@ def _check_scheme(scheme):
     return scheme
 
 
-def _check_volume(volume, what="the 27-point stencil of the spline schemes"):
-    vol = as_float64_array(volume, "volume", finite=False)
-    if vol.ndim != 3:
-        raise ValueError(f"volume must be a 3-D array of shape (nz, ny, nx) with volume[k, j, i] the value at "
-                         f"(x, y, z) = (i, j, k); got {vol.ndim}-D shape {vol.shape}.")
-    if min(vol.shape) < 2:
-        ax = "zyx"[int(np.argmin(vol.shape))]
-        raise ValueError(f"volume must have at least 2 samples along every axis ({what} reads one neighbour on each "
-                         f"side, and the boundary layer is extrapolated linearly from two samples); got shape "
-                         f"{vol.shape} with {min(vol.shape)} along {ax}. Resample or pad the data to >= 2 per axis.")
-    bad = ~np.isfinite(vol)
-    if bad.any():
-        k, j, i = (int(v) for v in np.argwhere(bad)[0])
-        raise ValueError(f"volume must be finite; found {int(bad.sum())} non-finite value(s), the first, "
-                         f"{float(vol[k, j, i])!r}, at voxel [k, j, i] = [{k}, {j}, {i}] (x={i}, y={j}, z={k}). "
-                         f"Replace them (e.g. by a background value) before building a spline.")
-    return vol
-
-
-def _pad(vol):
-    """Linear extrapolation by one layer, axis after axis (corners too), in one float64 allocation."""
-    v = np.asarray(vol, dtype=np.float64)
-    nz, ny, nx = v.shape
-    P = np.zeros((nz + 2, ny + 2, nx + 2))  # borders are all overwritten; zeros keep garbage out of the arithmetic
-    P[1:-1, 1:-1, 1:-1] = v
-    for ax in range(3):
-        Q = np.moveaxis(P, ax, 0)  # a view
-        np.subtract(2 * Q[1], Q[2], out=Q[0])
-        np.subtract(2 * Q[-2], Q[-3], out=Q[-1])
-    return P
-
-
-def pad_volume(volume) -> np.ndarray:
-    """The volume with one layer of linear extrapolation on every side (``f[-1] = 2 f[0] - f[1]``, axis by
-    axis, so edges and corners too): shape ``(nz + 2, ny + 2, nx + 2)``; ``padded[k + 1, j + 1, i + 1] =
-    volume[k, j, i]``. Linear data stay linear. Every axis needs >= 2 samples."""
-    return _pad(_check_volume(volume))
-
-
-def _stencil_data(vol):
-    """(nz, ny, nx, 27) data of every cube's 27-point stencil (padded volume)."""
-    P = _pad(vol)
-    nz, ny, nx = vol.shape
-    return np.stack([P[1 + oz:1 + oz + nz, 1 + oy:1 + oy + ny, 1 + ox:1 + ox + nx] for ox, oy, oz in STENCIL], axis=-1)
-
-
 def _point_weights(scheme):
     """(number of domain points, 27) weights and the (24, m) tetrahedron map of a scheme."""
     if scheme == "quadratic":
         return _weights()[0], _domain()[1]
-    from . import cubic  # noqa: PLC0415  (cubic imports this module)
-    return cubic._weights()[0], cubic._domain()[1]
+    return _cubic._weights()[0], _cubic._domain()[1]
 
 
 @functools.lru_cache(maxsize=None)
@@ -419,7 +352,7 @@ def spline_coefficients(volume, scheme: str) -> np.ndarray:
     scheme = _check_scheme(scheme)
     vol = _check_volume(volume)
     W, tmap = _point_weights(scheme)
-    return (_stencil_data(vol) @ W.T)[..., tmap]
+    return _apply_point_weights(vol, W, tmap)
 
 
 def _check_cubes(cubes, shape):

@@ -1,5 +1,5 @@
 // Restriction of a quartic Bernstein-Bezier triangle patch to a segment, by blossoming.
-#include "lib/blossom_steps.glsl"
+#include "lib/simplex/blossom_steps.glsl"
 //
 // The 15 coefficients b[q] are ordered as splinevis.bb.simplex.multi_indices(4, 2) (lexicographic
 // descending: (4,0,0), (3,1,0), (3,0,1), (2,2,0), (2,1,1), (2,0,2), (1,3,0), ...).  Along the segment
@@ -31,7 +31,7 @@ void sv_blossom_tri_step(float src[15], int m, vec3 l, out float dst[15]) {
 
 // c[k] = blossom(l0^{4-k}, l1^k) of the quartic triangle patch b (k = 0..4): 4 - k steps with l0, then
 // k steps with l1, exactly the order of the float64 twin, unrolled into fixed-degree steps
-// (lib/blossom_steps.glsl) so that no local array is indexed dynamically: 55 three-term combinations.
+// (lib/simplex/blossom_steps.glsl) so that no local array is indexed dynamically: 55 three-term combinations.
 void sv_restrict_quartic_tri(float b[15], vec3 l0, vec3 l1, out float c[5]) {
     float a1[10];
     float a2[6];

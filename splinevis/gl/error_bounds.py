@@ -1,12 +1,19 @@
-"""Derived error bounds for comparing float32 GPU results with float64 references."""
+"""Derived error bounds for comparing float32 GPU results with float64 references.
+
+Every spline program's ``depth_bound`` (:class:`splinevis.gl.contract.SplineProgram`) is built from these:
+the per-pixel window-depth error a float32 ray cast may make against its float64 twin, derived from the
+rounding errors of each step (no tuned constants), plus the rasterizer's sub-pixel snapping.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rays import window_depth
+from .camera import window_depth
 
-__all__ = ["U32", "ray_depth_error_bound"]
+__all__ = ["U32", "SUBPIXEL", "ray_depth_error_bound", "isosurface_depth_error_bound", "subpixel_depth_slack", "root_shift",
+           "depth_error",
+           "model_frame_matrix"]
 
 #: float32 unit roundoff
 U32 = 2.0 ** -24
@@ -59,7 +66,7 @@ def ray_depth_error_bound(gradient, coef_max, matrix, origins, directions, t, co
         return np.einsum("...i,...i->...", gradient(q[..., :2]), d[..., :2]) - d[..., 2]
 
     gsecond = np.abs(slope(t + h) - slope(t - h)) / (2 * h)
-    return _depth_error(matrix, o, d, t, h, _root_shift(eps, gprime, gsecond))
+    return depth_error(matrix, o, d, t, h, root_shift(eps, gprime, gsecond))
 
 
 def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matrix, origins, directions, t,
@@ -102,18 +109,18 @@ def isosurface_depth_error_bound(value_and_gradient, value_scale, spacing, matri
         return np.einsum("...i,...i->...", value_and_gradient(q)[1], d)
 
     gsecond = np.abs(slope(t + dl) - slope(t - dl)) / (2 * dl)
-    dt = _root_shift(eps, gprime, gsecond) + 4.0 * U32 * model_extent / np.linalg.norm(d, axis=-1)
-    return _depth_error(matrix, o, d, t, dl, dt)
+    dt = root_shift(eps, gprime, gsecond) + 4.0 * U32 * model_extent / np.linalg.norm(d, axis=-1)
+    return depth_error(matrix, o, d, t, dl, dt)
 
 
-def _root_shift(eps, gprime, gsecond):
+def root_shift(eps, gprime, gsecond):
     """Bound on the move of a root of g when g is perturbed by at most eps: 2 eps / |g'| for simple roots
     (2 |g''| eps < g'^2), else 2 sqrt(2 eps / |g''|) (near-tangential rays, double roots)."""
     simple = 2.0 * gsecond * eps < gprime ** 2
     return np.where(simple, 2.0 * eps / np.maximum(gprime, 1e-300), 2.0 * np.sqrt(2.0 * eps / np.maximum(gsecond, 1e-300)))
 
 
-def _depth_error(matrix, o, d, t, h, dt):
+def depth_error(matrix, o, d, t, h, dt):
     """Window-depth error of a hit at ray parameter t known to within dt: |d depth/dt| dt, plus the float32
     clip-space arithmetic (clip z and w are 4-term dot products, 4 u sum |M_ij p_j| each; ndc = z / w; window
     depth = half of it plus a rounding) and the 2^-24 depth-buffer quantization."""
@@ -127,3 +134,50 @@ def _depth_error(matrix, o, d, t, h, dt):
     s3 = np.abs(ph * m[3]).sum(axis=-1)
     depth_arith = 0.5 * (4.0 * U32 * (s2 + np.abs(ndc) * s3) / np.abs(w) + U32) + U32
     return dd_dt * dt + depth_arith + 2.0 ** -24
+
+
+def model_frame_matrix(matrix, offset) -> np.ndarray:
+    """The camera matrix acting on model-frame points (world = model + ``offset``).
+
+    >>> import numpy as np
+    >>> model_frame_matrix(np.eye(4), (1.0, 2.0, 3.0))[:3, 3]
+    array([1., 2., 3.])
+    """
+    T = np.eye(4)
+    T[:3, 3] = np.asarray(offset, dtype=np.float64).reshape(3)
+    return np.asarray(matrix, dtype=np.float64) @ T
+
+
+#: Sub-pixel precision of the rasterizer: vertices are snapped to 2^-8 of a pixel (llvmpipe's fixed-point
+#: setup, FIXED_ORDER = 8; the same order as GPUs' 8 sub-pixel bits).
+SUBPIXEL = 2.0 ** -8
+
+
+def subpixel_depth_slack(ref_depth: np.ndarray) -> np.ndarray:
+    """Depth change over a sub-pixel offset of the ray: ``SUBPIXEL * (|d depth/dx| + |d depth/dy|)`` per pixel.
+
+    The shader's ray passes through the fragment's interpolated position on the proxy, and the proxy's
+    vertices were snapped to SUBPIXEL before interpolation: the ray is that of a point up to SUBPIXEL
+    (per axis) away from the pixel centre (found on a one-voxel sheet whose isosurface lies on cube faces).
+    The slope is the larger one-sided difference of the float64 reference depth to a neighbour that also
+    hits (0 where none does).
+
+    >>> import numpy as np
+    >>> float(subpixel_depth_slack(np.array([[0.5, 0.5 + 2.0 ** -10]]))[0, 0]) == SUBPIXEL * 2.0 ** -10
+    True
+    """
+    r = np.asarray(ref_depth, dtype=np.float64)
+    ok = np.isfinite(r) & (r >= 0) & (r <= 1)
+    slope = np.zeros_like(r)
+    for axis in (0, 1):
+        per_axis = np.zeros_like(r)
+        for shift in (1, -1):
+            nb = np.roll(r, shift, axis=axis)
+            nok = np.roll(ok, shift, axis=axis)
+            edge = np.zeros_like(ok)
+            index = [slice(None), slice(None)]
+            index[axis] = 0 if shift == 1 else -1
+            edge[tuple(index)] = True
+            per_axis = np.maximum(per_axis, np.where(ok & nok & ~edge, np.abs(r - nb), 0.0))
+        slope += per_axis
+    return SUBPIXEL * slope

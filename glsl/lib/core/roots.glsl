@@ -9,10 +9,10 @@
 //   roots, and to overshoot out of [0, 1] when the root sits near s = 1 (ray-caster holes at patch borders).
 // * sv_first_root_bracketed -- bracketed Newton on convex pieces (the default, see below).
 //
-// sv_first_root(c, n, iterations) is the bracketed method unless SV_ROOTS_PAPER_NEWTON is defined.
+// sv_first_root(c, n, iterations) is the bracketed method unless SV_ROOTS_PAPER is defined.
 // The float64 twins are splinevis.bb.roots.newton_secure and splinevis.bb.roots.first_root_bracketed;
 // they mirror this file line by line.
-#include "lib/bernstein.glsl"
+#include "lib/core/bernstein.glsl"
 
 // Acceptance constant K_n (in units of eps32 = 2^-23) of the residual test |f(x)| <= K_n eps32 S(x),
 // S(x) = sum_k |c_k| B^n_k(x).  Derivation (u = 2^-24 = eps32 / 2):
@@ -266,9 +266,9 @@ float sv_first_root_bracketed(float c[5], int n, int iterations) {
 }
 
 // The method the ray-cast programs use: bracketed Newton on convex pieces, or paper 000's 4-start
-// Newton iteration when SV_ROOTS_PAPER_NEWTON is defined (for comparison).
+// Newton iteration when SV_ROOTS_PAPER is defined (for comparison).
 float sv_first_root(float c[5], int n, int iterations) {
-#ifdef SV_ROOTS_PAPER_NEWTON
+#ifdef SV_ROOTS_PAPER
     return sv_first_root_newton4(c, n, iterations);
 #else
     return sv_first_root_bracketed(c, n, iterations);

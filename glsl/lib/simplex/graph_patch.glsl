@@ -9,9 +9,9 @@
 //    function written as a quartic: c_k -= z0 + (k/4)(z1 - z0).
 // 3. No sign change among the c_k: no root (convex hull), skip the root finder; else the first root.
 // The float64 twin is splinevis.bb.ray.graph_patch_first_hit.
-#include "lib/raycast.glsl"
-#include "lib/blossom.glsl"
-#include "lib/roots.glsl"
+#include "lib/core/raycast.glsl"
+#include "lib/simplex/blossom.glsl"
+#include "lib/core/roots.glsl"
 
 
 float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz, float ta, float tb, float margin,

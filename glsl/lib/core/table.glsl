@@ -1,0 +1,14 @@
+// Table textures: float data packed four per RGBA32F texel, SV_TABLE_WIDTH texels per row, read with
+// texelFetch (no filtering, exact float32). Texel n sits at (n % W, n / W). The Python side is
+// splinevis.gl.proxies.pack_rgba32f; the width is the same for every program (a test checks the two).
+const int SV_TABLE_WIDTH = 8192;
+
+vec4 sv_table_texel(sampler2D table, int n) {
+    return texelFetch(table, ivec2(n % SV_TABLE_WIDTH, n / SV_TABLE_WIDTH), 0);
+}
+
+// Float number n of the table (four per texel).
+float sv_table_float(sampler2D table, int n) {
+    int texel = n / 4;
+    return sv_table_texel(table, texel)[n - 4 * texel];
+}

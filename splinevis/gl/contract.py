@@ -1,0 +1,234 @@
+"""The spline-program contract: what a spline family provides so that the rest of splinevis can draw it,
+check it against float64 and study it without knowing its type.
+
+A family (a folder such as ``splinevis/terrain``) declares one :class:`SplineProgram` in its
+``program.py`` and the registry (:mod:`splinevis.programs`) lists it. :meth:`splinevis.Plotter.add_spline`,
+the per-pixel agreement analysis (:mod:`splinevis.analysis.agreement`), the self-test and the studies look
+programs up there by the model they are given; nothing outside the family's folder branches on its type.
+
+Kinds (how the pixels are made):
+
+``raycast``
+    A proxy mesh is rasterized and every fragment ray-casts the spline (``build`` returns a
+    :class:`~splinevis.gl.spec.ProgramSpec` whose entry defines ``sv_surface_hit``): terrains, volumes.
+``surface``
+    A mesh carrying surface parameters is rasterized and every fragment evaluates the surface exactly at its
+    parameters (``build`` returns a ProgramSpec whose entry defines ``sv_surface_eval``): NURBS.
+``passes``
+    A chain of render-to-texture passes (:mod:`splinevis.gl.passes`) computes the geometry; ``build``
+    returns a PyVista dataset (or a texture on one) that is drawn as a mesh: smooth geometry images.
+``mesh``
+    The CPU tessellates (levels of detail, error bounds); ``build`` returns a PyVista dataset: large models.
+
+Kinds ``raycast`` and ``surface`` become a :class:`~splinevis.gl.inject.SplineActor`; ``passes`` and ``mesh``
+become an ordinary mesh actor with the scene's effects compiled in (:mod:`splinevis.gl.mesh_effects`).
+Only ``raycast`` programs have a float64 ray caster (``reference``) and a derived ``depth_bound``: the
+per-pixel agreement check needs both and refuses programs without them.
+
+How to add a family: ``docs/architecture.md``.
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+__all__ = ["KINDS", "SplineProgram", "HardCase", "RayHits"]
+
+#: The four ways a program makes its pixels (module docstring).
+KINDS = ("raycast", "surface", "passes", "mesh")
+
+
+class RayHits:
+    """Result of a float64 ray cast, the one return type of every family's ``reference``.
+
+    Attributes
+    ----------
+    t : (...) float64 ndarray
+        Ray parameter of the first hit, NaN on a miss.
+    points : (..., 3) float64 ndarray
+        World hit points (NaN on a miss).
+    normals : (..., 3) float64 ndarray
+        World normals at the hits, not necessarily unit (NaN on a miss).
+    hit : (...) bool ndarray
+        ``isfinite(t)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = RayHits(np.array([1.0, np.nan]), np.zeros((2, 3)), np.zeros((2, 3)))
+    >>> h.hit.tolist()
+    [True, False]
+    """
+
+    __slots__ = ("t", "points", "normals", "hit")
+
+    def __init__(self, t, points, normals):
+        self.t = t
+        self.points = points
+        self.normals = normals
+        self.hit = np.isfinite(t)
+
+    def __repr__(self):
+        return f"RayHits(rays={self.t.size}, hits={int(self.hit.sum())})"
+
+
+@dataclass(frozen=True)
+class HardCase:
+    """One scene a family says is numerically hard (grazing rays, huge coordinates, flat data, ...).
+
+    Tests and the self-test render it and compare the GPU with the float64 reference per pixel
+    (:func:`splinevis.analysis.agreement.depth_agreement`).
+
+    Attributes
+    ----------
+    name : str
+        What makes it hard, as a test id (``"grazing-1-degree"``).
+    model : callable
+        ``model()`` builds the model (deferred: building can take a while).
+    camera : list or callable
+        A PyVista camera position ``[eye, focal point, view up]`` in world coordinates, or
+        ``camera(model)`` returning one (for views placed relative to the data).
+    window_size : (int, int)
+    program_options : dict
+        Passed to the family's ``build``.
+    newton_iterations : int or None
+        None: the family's default.
+    clipping_range : (float, float) or None
+        Set after the camera (cameras inside the model need a near plane close to the eye).
+    depth_fraction : float
+        Fraction of pixels where both hit whose depth error must be within the derived bound.
+    max_disagree : float
+        Largest fraction of pixels where exactly one side hits (silhouettes grazed within rounding).
+    min_hits : float
+        Smallest fraction of pixels where both hit: a case that shows (almost) nothing tests nothing.
+    """
+
+    name: str
+    model: Callable[[], Any]
+    camera: list
+    window_size: tuple = (160, 120)
+    program_options: dict = field(default_factory=dict)
+    newton_iterations: int | None = None
+    clipping_range: tuple | None = None
+    depth_fraction: float = 0.999
+    max_disagree: float = 0.001
+    min_hits: float = 0.02
+
+    def camera_for(self, model) -> list:
+        """The camera position for ``model``."""
+        return self.camera(model) if callable(self.camera) else self.camera
+
+
+@dataclass(frozen=True)
+class SplineProgram:
+    """What one spline family provides (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Registry key, e.g. ``"terrain"``.
+    kind : {"raycast", "surface", "passes", "mesh"}
+    model_type : type
+        The model class the program draws (subclasses too).
+    build : callable
+        ``build(model, style, *, newton_iterations, **options) -> ProgramSpec`` (raycast, surface) or a
+        PyVista dataset (passes, mesh). Validates ``options`` and raises ``TypeError``/``ValueError`` naming
+        the bad one.
+    reference : callable, optional
+        The float64 twin: ``reference(model, origins, directions, tmin=0.0, *, method="reference",
+        iterations=None) -> RayHits`` for world rays of any leading shape; ``method`` is ``"reference"``
+        (robust: every root isolated) or one of ``root_methods`` (the GPU's method in float64).
+    depth_bound : callable, optional
+        ``depth_bound(model, matrix, origins, directions, t) -> (n,) ndarray``: the derived bound on
+        |GPU window depth - float64 window depth| at hits ``origins + t directions`` (world, float64)
+        for the camera ``matrix`` (world -> NDC).
+    hard_cases : callable, optional
+        ``hard_cases() -> list of HardCase``.
+    model_from : callable, optional
+        ``model_from(data, *args, **kwargs)`` builds a model from user data (arrays, files, grids); what
+        the Plotter's convenience methods call.
+    on_add : callable, optional
+        ``on_add(actor, plotter, **options)`` after the actor is in the scene (e.g. frustum culling).
+    root_methods : tuple of str
+        GPU root finders the program compiles (``splinevis.bb.root_options``), first = default.
+    newton_iterations : int
+        Default iteration count of the root finder.
+    options : tuple of str
+        Names of the program options ``build`` accepts (for messages and documentation).
+    description : str
+        One line for listings.
+    """
+
+    name: str
+    kind: str
+    model_type: type
+    build: Callable
+    reference: Callable | None = None
+    depth_bound: Callable | None = None
+    hard_cases: Callable | None = None
+    model_from: Callable | None = None
+    on_add: Callable | None = None
+    root_methods: tuple = ()
+    newton_iterations: int = 8
+    options: tuple = ()
+    description: str = ""
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"SplineProgram.name must be an identifier-like string, got {self.name!r}.")
+        if self.kind not in KINDS:
+            raise ValueError(f"SplineProgram {self.name!r}: kind must be one of {', '.join(KINDS)}; got {self.kind!r}.")
+        if not isinstance(self.model_type, type):
+            raise TypeError(f"SplineProgram {self.name!r}: model_type must be a class, got {self.model_type!r}.")
+        if not callable(self.build):
+            raise TypeError(f"SplineProgram {self.name!r}: build must be callable.")
+        if self.kind == "raycast" and (self.reference is None or self.depth_bound is None):
+            raise ValueError(f"SplineProgram {self.name!r}: a raycast program needs its float64 twin "
+                             "(reference) and its derived depth_bound; the tests compare the GPU against them.")
+
+    def accepts(self, model) -> bool:
+        """Whether this program draws ``model`` (an instance of ``model_type`` or of a subclass)."""
+        return isinstance(model, self.model_type)
+
+    def make(self, model, style, *, newton_iterations: int | None = None, **options):
+        """Call ``build`` with the program's default iteration count and the declared options only.
+
+        Unknown option names raise a ``TypeError`` that lists the known ones.
+        """
+        unknown = sorted(set(options) - set(self.options))
+        if unknown:
+            known = ", ".join(self.options) or "none"
+            raise TypeError(f"program {self.name!r} has no option {', '.join(map(repr, unknown))}; its options: {known}.")
+        its = self.newton_iterations if newton_iterations is None else newton_iterations
+        return self.build(model, style, newton_iterations=its, **options)
+
+    def raycast(self, model, origins, directions, tmin=0.0, *, method: str = "reference", iterations=None) -> RayHits:
+        """The float64 twin (``reference``) with this program's default iteration count."""
+        if self.reference is None:
+            raise TypeError(f"program {self.name!r} ({self.kind}) has no float64 ray caster.")
+        its = self.newton_iterations if iterations is None else iterations
+        return self.reference(model, origins, directions, tmin, method=method, iterations=its)
+
+    def signature_problems(self) -> list:
+        """Mismatches between the callables and the calling conventions above (empty when all is well);
+        the registry refuses a program with any."""
+        problems = []
+        checks = [("build", self.build, ("model", "style"), ("newton_iterations",)),
+                  ("reference", self.reference, ("model", "origins", "directions", "tmin"), ("method", "iterations")),
+                  ("depth_bound", self.depth_bound, ("model", "matrix", "origins", "directions", "t"), ())]
+        for label, fn, positional, keywords in checks:
+            if fn is None:
+                continue
+            params = inspect.signature(fn).parameters
+            names = list(params)
+            # the model parameter may have any name (``terrain``, ``patch``); the others are the contract's
+            if len(names) < len(positional) or names[1: len(positional)] != list(positional[1:]):
+                problems.append(f"{label} must take ({', '.join(positional)}, ...) first, takes ({', '.join(names)})")
+            for kw in keywords:
+                if kw not in params and not any(p.kind is p.VAR_KEYWORD for p in params.values()):
+                    problems.append(f"{label} must accept the keyword {kw!r}")
+        return problems

@@ -1,0 +1,100 @@
+"""The registry of spline programs: the one list of built-in families, and the place to add one.
+
+Everything that draws, checks or studies a model finds its program here by the model's type
+(:func:`program_for`) or by name (:func:`get`); nothing outside a family's folder knows its type.
+The built-in families are imported on first use, so ``import splinevis`` stays light.
+
+Examples
+--------
+>>> from splinevis import programs
+>>> [p.name for p in programs.all_programs()]
+['analytic_patch', 'terrain', 'isosurface']
+>>> programs.get("terrain").kind
+'raycast'
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from .gl.contract import SplineProgram
+
+__all__ = ["BUILTIN", "register", "unregister", "all_programs", "get", "program_for"]
+
+#: Modules whose ``PROGRAM`` is a built-in family, in listing order.
+BUILTIN = ("splinevis.analytic.program", "splinevis.terrain.program", "splinevis.volume.program")
+
+_programs: dict[str, SplineProgram] = {}
+_loaded = False
+
+
+def _load_builtin() -> None:
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True
+    for module in BUILTIN:
+        program = importlib.import_module(module).PROGRAM
+        _programs.setdefault(program.name, program)
+
+
+def register(program: SplineProgram, *, replace: bool = False) -> SplineProgram:
+    """Add a family. Its callables must follow the contract (:class:`~splinevis.gl.contract.SplineProgram`).
+
+    Raises
+    ------
+    TypeError
+        ``program`` is not a SplineProgram, or a callable has the wrong calling convention.
+    ValueError
+        A program of that name is registered already (pass ``replace=True`` to replace it).
+    """
+    if not isinstance(program, SplineProgram):
+        raise TypeError(f"register takes a splinevis.gl.contract.SplineProgram, got {type(program).__name__}.")
+    problems = program.signature_problems()
+    if problems:
+        raise TypeError(f"program {program.name!r} does not follow the contract: " + "; ".join(problems) + ".")
+    _load_builtin()
+    if program.name in _programs and not replace:
+        raise ValueError(f"a program named {program.name!r} is registered already; pass replace=True to replace it.")
+    _programs[program.name] = program
+    return program
+
+
+def unregister(name: str) -> None:
+    """Remove the family ``name`` (built-in families come back only in a new process)."""
+    _load_builtin()
+    if name not in _programs:
+        raise KeyError(f"no program named {name!r}; registered: {', '.join(_programs)}.")
+    del _programs[name]
+
+
+def all_programs() -> list[SplineProgram]:
+    """Every registered program, built-in ones first."""
+    _load_builtin()
+    return list(_programs.values())
+
+
+def get(name: str) -> SplineProgram:
+    """The program registered as ``name``."""
+    _load_builtin()
+    try:
+        return _programs[name]
+    except KeyError:
+        raise KeyError(f"no program named {name!r}; registered: {', '.join(_programs)}.") from None
+
+
+def program_for(model) -> SplineProgram:
+    """The program that draws ``model``: the one whose model type is nearest in the model's class hierarchy.
+
+    Raises
+    ------
+    TypeError
+        No registered program draws this type; the message lists what can be drawn.
+    """
+    _load_builtin()
+    for cls in type(model).__mro__:
+        for program in reversed(list(_programs.values())):  # later registrations win on the same type
+            if program.model_type is cls:
+                return program
+    known = ", ".join(f"{p.model_type.__name__} ({p.name})" for p in _programs.values())
+    raise TypeError(f"no spline program draws a {type(model).__name__}; registered programs draw: {known}.")

@@ -1,0 +1,81 @@
+"""Scenes where a float32 terrain ray cast is most likely to part from its float64 twin.
+
+Each is a :class:`~splinevis.gl.contract.HardCase` that the tests and the self-test render and compare per
+pixel (:func:`splinevis.analysis.agreement.depth_agreement`): grazing rays, rays along grid lines and through
+vertices, the underside, a camera inside the bounding box, UTM-sized coordinates, extreme zoom, flat and almost
+flat data. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..gl.contract import HardCase
+from .model import TerrainSpline
+
+__all__ = ["hard_cases", "franke_terrain"]
+
+
+def franke_terrain(n: int = 24, scheme: str = "C2-cubic", spacing=(1.0 / 24, 1.0 / 24), origin=(0.0, 0.0),
+                   height_offset: float = 0.0, height_scale: float = 1.0) -> TerrainSpline:
+    """Franke's function [Franke1982] sampled on n x n points as a terrain spline."""
+    from datasets_synthetic.franke import franke_grid
+
+    z, _ = franke_grid(n)
+    return TerrainSpline.from_heights(z.T * height_scale + height_offset, scheme, spacing=spacing, origin=origin)
+
+
+_franke = functools.lru_cache(maxsize=1)(franke_terrain)
+
+
+def _utm():
+    # UTM-sized origin and heights 2000 +- 0.5: only the local frame keeps float32 precision here.
+    return franke_terrain(spacing=(10.0, 10.0), origin=(500_000.0, 5_100_000.0), height_offset=2000.0, height_scale=0.5)
+
+
+def _utm_camera(t):
+    x0, x1, y0, y1 = t.extent
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    return [(cx - 300, cy - 350, 2300.0), (cx, cy, 2000.3), (0, 0, 1)]
+
+
+def _inside_camera(t):
+    eye = (0.3, 0.2, float(t.evaluate(0.3, 0.2)) + 0.05)  # below the top of the bounding box
+    return [eye, (0.7, 0.7, 0.2), (0, 0, 1)]
+
+
+def _zoom_camera(t):
+    x, y = 0.51, 0.52
+    z = float(t.evaluate(x, y))
+    return [(x - 0.01, y - 0.012, z + 0.01), (x, y, z), (0, 0, 1)]
+
+
+def _flat(almost: bool):
+    z = np.full((17, 17), 250.0)
+    if almost:
+        z[8, 8] += 1e-4
+    return TerrainSpline.from_heights(z, "C1", spacing=(1.0, 1.0))
+
+
+def hard_cases() -> list:
+    """The terrain's hard cases (module docstring), 400 x 300 pixels each."""
+    size = (400, 300)
+    grazing_z = 1.25
+    flat_view = [(-6.0, -9.0, 262.0), (8.0, 8.0, 250.0), (0, 0, 1)]
+    x = 12 / 24  # the eye exactly above a grid line, looking along it: a column of rays runs along cell edges
+    return [
+        HardCase("oblique", _franke, [(-0.6, -0.9, 1.4), (0.5, 0.5, 0.3), (0, 0, 1)], size, min_hits=0.05),
+        HardCase("grazing-1-degree", _franke, [(-3.0, 0.45, grazing_z),
+                                               (0.5, 0.5, grazing_z - 3.5 * np.tan(np.radians(1.0))), (0, 0, 1)],
+                 size, min_hits=0.05),
+        HardCase("along-grid-lines", _franke, [(x, -1.0, 1.5), (x, 0.5, 0.2), (0, 0, 1)], size, min_hits=0.05),
+        HardCase("along-diagonals", _franke, [(-0.5, -0.5, 1.6), (0.5, 0.5, 0.2), (0, 0, 1)], size, min_hits=0.05),
+        HardCase("underside", _franke, [(0.5, -0.8, -1.0), (0.5, 0.5, 0.3), (0, 0, 1)], size, min_hits=0.05),
+        HardCase("camera-inside-box", _franke, _inside_camera, size, clipping_range=(1e-3, 5.0), min_hits=0.05),
+        HardCase("utm-coordinates", _utm, _utm_camera, size, min_hits=0.05),
+        HardCase("extreme-zoom", _franke, _zoom_camera, size, clipping_range=(1e-4, 2.0), min_hits=0.05),
+        HardCase("flat", functools.partial(_flat, False), flat_view, size, min_hits=0.05),
+        HardCase("almost-flat", functools.partial(_flat, True), flat_view, size, min_hits=0.05),
+    ]

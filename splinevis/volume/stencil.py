@@ -1,0 +1,82 @@
+"""The 27-point data stencil of a cube and the padded volume it reads, shared by both volume schemes.
+
+Every data point ``volume[k, j, i]`` is the centre of one cube; a scheme sets each BB coefficient of the
+cube as a fixed combination of the 27 values at the offsets :data:`STENCIL` around it, reading one layer
+of linear extrapolation (``f[-1] = 2 f[0] - f[1]``) beyond the boundary.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validation import as_float64_array
+
+__all__ = ["STENCIL", "pad_volume"]
+
+#: Data offsets (x, y, z) of the 27-point stencil of a cube, z slowest, x fastest.
+STENCIL = np.array([(x, y, z) for z in (-1, 0, 1) for y in (-1, 0, 1) for x in (-1, 0, 1)], dtype=np.int64)
+_BIG = np.array([(x, y, z) for z in range(-2, 3) for y in range(-2, 3) for x in range(-2, 3)], dtype=np.int64)
+_BIG_ID = {tuple(int(v) for v in o): n for n, o in enumerate(_BIG)}
+_S27 = np.array([_BIG_ID[tuple(int(v) for v in o)] for o in STENCIL])
+
+
+def _lift(M27, shift):
+    """(..., 27) stencil weights of the cube at offset `shift` -> (..., 125) weights on offsets -2..2."""
+    out = np.zeros(M27.shape[:-1] + (125,))
+    for j, o in enumerate(STENCIL):
+        out[..., _BIG_ID[tuple(int(v) for v in o + shift)]] += M27[..., j]
+    return out
+
+
+def _check_volume(volume, what="the 27-point stencil of the spline schemes"):
+    """``volume`` as a finite 3-D float64 array with >= 2 samples per axis, else ValueError (``what`` names
+    the reader of the neighbours in the message)."""
+    vol = as_float64_array(volume, "volume", finite=False)
+    if vol.ndim != 3:
+        raise ValueError(f"volume must be a 3-D array of shape (nz, ny, nx) with volume[k, j, i] the value at "
+                         f"(x, y, z) = (i, j, k); got {vol.ndim}-D shape {vol.shape}.")
+    if min(vol.shape) < 2:
+        ax = "zyx"[int(np.argmin(vol.shape))]
+        raise ValueError(f"volume must have at least 2 samples along every axis ({what} reads one neighbour on each "
+                         f"side, and the boundary layer is extrapolated linearly from two samples); got shape "
+                         f"{vol.shape} with {min(vol.shape)} along {ax}. Resample or pad the data to >= 2 per axis.")
+    bad = ~np.isfinite(vol)
+    if bad.any():
+        k, j, i = (int(v) for v in np.argwhere(bad)[0])
+        raise ValueError(f"volume must be finite; found {int(bad.sum())} non-finite value(s), the first, "
+                         f"{float(vol[k, j, i])!r}, at voxel [k, j, i] = [{k}, {j}, {i}] (x={i}, y={j}, z={k}). "
+                         f"Replace them (e.g. by a background value) before building a spline.")
+    return vol
+
+
+def _pad(vol):
+    """Linear extrapolation by one layer, axis after axis (corners too), in one float64 allocation."""
+    v = np.asarray(vol, dtype=np.float64)
+    nz, ny, nx = v.shape
+    P = np.zeros((nz + 2, ny + 2, nx + 2))  # borders are all overwritten; zeros keep garbage out of the arithmetic
+    P[1:-1, 1:-1, 1:-1] = v
+    for ax in range(3):
+        Q = np.moveaxis(P, ax, 0)  # a view
+        np.subtract(2 * Q[1], Q[2], out=Q[0])
+        np.subtract(2 * Q[-2], Q[-3], out=Q[-1])
+    return P
+
+
+def pad_volume(volume) -> np.ndarray:
+    """The volume with one layer of linear extrapolation on every side (``f[-1] = 2 f[0] - f[1]``, axis by
+    axis, so edges and corners too): shape ``(nz + 2, ny + 2, nx + 2)``; ``padded[k + 1, j + 1, i + 1] =
+    volume[k, j, i]``. Linear data stay linear. Every axis needs >= 2 samples."""
+    return _pad(_check_volume(volume))
+
+
+def _stencil_data(vol):
+    """(nz, ny, nx, 27) data of every cube's 27-point stencil (padded volume)."""
+    P = _pad(vol)
+    nz, ny, nx = vol.shape
+    return np.stack([P[1 + oz:1 + oz + nz, 1 + oy:1 + oy + ny, 1 + ox:1 + ox + nx] for ox, oy, oz in STENCIL], axis=-1)
+
+
+def _apply_point_weights(vol, W, tmap):
+    """BB coefficients ``(nz, ny, nx, 24, m)`` of every cube of ``vol`` (checked) from the domain-point
+    weights ``W`` (number of domain points, 27) and the tetrahedron map ``tmap`` (24, m)."""
+    return (_stencil_data(vol) @ W.T)[..., tmap]

@@ -1,0 +1,90 @@
+"""A family from the tests folder joins splinevis through the registry alone: drawn by add_spline, checked
+per pixel against its float64 twin on its hard cases, listed by the self-test, removed again. No package file
+knows it (docs/architecture.md)."""
+
+import numpy as np
+import pytest
+
+import splinevis
+from splinevis import programs
+from splinevis.analysis.agreement import agreement_failures, hard_case_agreement
+from splinevis.selftest import program_hard_cases
+
+from toy_family import MESH, RAYCAST, ToyMeshSphere, ToySphere, build
+
+pytestmark = pytest.mark.gl
+
+
+@pytest.fixture
+def toys():
+    programs.register(RAYCAST)
+    programs.register(MESH)
+    yield
+    programs.unregister(RAYCAST.name)
+    programs.unregister(MESH.name)
+
+
+def test_toy_raycast_family_draws_and_matches_its_twin(toys):
+    assert programs.program_for(ToySphere()) is RAYCAST
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_spline(ToySphere(), lights=1, color="tan")
+    pl.camera_position = [(3.0, -4.0, 2.0), (0.0, 0.0, 0.0), (0, 0, 1)]
+    img = pl.screenshot()
+    assert actor.program is RAYCAST and "sv_toy_radius" in actor.program_sources["fragment"]
+    assert (pl.depth_buffer() < 1).sum() > 2000 and img.std() > 10
+    pl.close()
+    for case in RAYCAST.hard_cases():
+        r = hard_case_agreement(case)
+        assert agreement_failures(r, case) == [], case.name
+
+
+def test_selftest_runs_registered_families(toys):
+    report = program_hard_cases(progress=False)
+    assert set(report["toy_sphere"]) == {c.name for c in RAYCAST.hard_cases()}
+    assert all(row["pass"] for row in report["toy_sphere"].values())
+    assert "toy_mesh_sphere" not in report  # no float64 ray caster: nothing to compare per pixel
+
+
+def test_toy_mesh_family_is_drawn_as_a_mesh_with_effects(toys):
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_spline(ToyMeshSphere(), reflection_lines=8, program_options={"resolution": 48})
+    pl.camera_position = [(3.0, -4.0, 2.0), (0.0, 0.0, 0.0), (0, 0, 1)]
+    img = pl.screenshot().astype(int)
+    assert actor.GetMapper().GetInput().GetNumberOfPoints() == 48 * 46 + 2
+    assert (pl.depth_buffer() < 1).sum() > 2000
+    assert img[..., 0].std() > 20  # stripes, not a flat disc
+    pl.close()
+    with pytest.raises(ValueError, match="cannot show the effects isophotes"):
+        pl2 = splinevis.Plotter(off_screen=True, window_size=(40, 30))
+        try:
+            pl2.add_spline(ToyMeshSphere(), isophotes=4)
+        finally:
+            pl2.close()
+
+
+def test_registry_refuses_bad_programs_and_duplicates(toys):
+    with pytest.raises(ValueError, match="registered already"):
+        programs.register(RAYCAST)
+    bad = RAYCAST.__class__(name="toy_bad", kind="raycast", model_type=ToySphere, build=lambda m: None,
+                            reference=RAYCAST.reference, depth_bound=RAYCAST.depth_bound)
+    with pytest.raises(TypeError, match="does not follow the contract"):
+        programs.register(bad)
+    with pytest.raises(ValueError, match="kind must be one of raycast, surface, passes, mesh"):
+        RAYCAST.__class__(name="x", kind="shader", model_type=ToySphere, build=build)
+    with pytest.raises(ValueError, match="needs its float64 twin"):
+        RAYCAST.__class__(name="x", kind="raycast", model_type=ToySphere, build=build)
+    with pytest.raises(TypeError, match="has no option 'radius'"):
+        splinevis.Plotter(off_screen=True).add_spline(ToySphere(), program_options={"radius": 2})
+
+
+def test_after_unregistering_the_toy_is_unknown():
+    with pytest.raises(TypeError, match="no spline program draws a ToySphere"):
+        programs.program_for(ToySphere())
+    assert [p.name for p in programs.all_programs()] == ["analytic_patch", "terrain", "isosurface"]
+
+
+def test_every_builtin_program_follows_the_contract():
+    for p in programs.all_programs():
+        assert p.signature_problems() == [], p.name
+        assert p.kind in ("raycast", "surface", "passes", "mesh")
+        assert p.hard_cases is not None and len(p.hard_cases()) >= 3, p.name
