@@ -1,0 +1,215 @@
+"""Volume samples as a source stores them, and the checks every volume reader applies to them.
+
+Every volume reader (numpy arrays here, pyvista/VTK objects and files in :mod:`.volume_vtk`, NRRD in
+:mod:`.nrrd`, headerless files in :mod:`.raw`) hands a :class:`VolumeSamples` to
+:func:`splinevis.io.read_volume`, which reverses flipped axes, reports or fills NaN/inf samples and
+returns a :class:`~splinevis.io.VolumeGrid`. Shared here: multi-component arrays (``component=``),
+the minimum size, and direction matrices that are only axis flips.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._common import check_exact_in_float64, check_real_dtype
+
+__all__ = ["VolumeSamples", "GEOMETRY_ARGS_APPLY_TO", "check_samples", "check_size", "pick_component", "from_array",
+           "axis_signs"]
+
+#: The sources ``spacing=``/``origin=`` are meant for (the others carry their own geometry).
+GEOMETRY_ARGS_APPLY_TO = "numpy arrays and raw files"
+
+
+@dataclass
+class VolumeSamples:
+    """Samples in the source's dtype and order, with the geometry of the grid they become.
+
+    Parameters
+    ----------
+    values : (nz, ny, nx) ndarray
+        In the source's dtype and stored order.
+    spacing, origin : (3,) tuples
+        Already describe the flipped (returned) grid: spacing > 0, origin at the smallest coordinates.
+    source : str
+        Where the data came from.
+    scalars : str or None
+        Name of the array read, if the source names it.
+    flips : (3,) bools
+        ``flips[a]`` reverses axis ``a`` (x, y, z) of ``values``.
+    """
+
+    values: np.ndarray
+    spacing: tuple
+    origin: tuple
+    source: str
+    scalars: str | None = None
+    flips: tuple = (False, False, False)
+
+    @classmethod
+    def from_steps(cls, values, first, steps, counts, source: str, scalars=None) -> VolumeSamples:
+        """Samples whose stored index runs with signed world ``steps`` from the ``first`` stored point.
+
+        Parameters
+        ----------
+        values : (nz, ny, nx) ndarray
+            In stored order.
+        first : (3,) floats
+            World position of the first stored sample.
+        steps : (3,) floats
+            Signed world step of the stored index along x, y, z; a negative step flips that axis.
+        counts : (3,) ints
+            Samples along x, y, z.
+        source, scalars : str
+            As in the class.
+
+        Returns
+        -------
+        VolumeSamples
+        """
+        flips = tuple(bool(s < 0) for s in steps)
+        origin = tuple(float(f + s * (m - 1)) if s < 0 else float(f) for f, s, m in zip(first, steps, counts))
+        return cls(values=values, spacing=tuple(float(abs(s)) for s in steps), origin=origin, source=source,
+                   scalars=scalars, flips=flips)
+
+    def oriented(self) -> np.ndarray:
+        """``values`` with the flipped axes reversed (a view)."""
+        v = self.values
+        fx, fy, fz = self.flips
+        v = v[::-1 if fz else 1, ::-1 if fy else 1, ::-1 if fx else 1]
+        return v
+
+
+def check_samples(arr: np.ndarray, where: str) -> None:
+    """Raise unless ``arr`` holds real numbers that float64 represents exactly.
+
+    Parameters
+    ----------
+    arr : ndarray
+        The samples.
+    where : str
+        The source, for the messages.
+    """
+    check_real_dtype(arr, where, "samples")
+    check_exact_in_float64(arr, where)
+
+
+def check_size(shape, where: str) -> None:
+    """Raise ValueError unless every axis of ``shape`` (nz, ny, nx) has at least 2 samples.
+
+    Parameters
+    ----------
+    shape : (3,) ints
+        ``(nz, ny, nx)``.
+    where : str
+        The source, for the message.
+    """
+    if min(shape) < 2:
+        axis = "zyx"[int(np.argmin(shape))]
+        raise ValueError(f"{where}: a volume needs at least 2 samples on every axis; shape (nz, ny, nx) = "
+                         f"{tuple(int(s) for s in shape)} has {min(shape)} along {axis}."
+                         + (" A single slice is a 2-D image (see splinevis.io.read_heights)." if min(shape) == 1
+                            else ""))
+
+
+def pick_component(arr: np.ndarray, ncomp: int, label: str, where: str, component) -> np.ndarray:
+    """One value per sample from an array with ``ncomp`` components on its last axis.
+
+    Parameters
+    ----------
+    arr : ndarray
+        Components on the last axis.
+    ncomp : int
+        Number of components.
+    label : str
+        The array, for the messages.
+    where : str
+        The source, for the messages.
+    component : None, int or "magnitude"
+        None raises (the choice is the caller's); an int picks that component (negative counts from
+        the end); ``"magnitude"`` takes the Euclidean norm.
+
+    Returns
+    -------
+    ndarray
+        ``arr`` without its last axis.
+    """
+    if component is None:
+        raise ValueError(f"{where}: array {label!r} has {ncomp} components per sample; a volume needs one. "
+                         f"Pass component=0..{ncomp - 1} to pick one or component='magnitude' for the norm.")
+    if component == "magnitude":
+        return np.sqrt(np.sum(np.square(arr.astype(np.float64)), axis=-1))
+    if not -ncomp <= int(component) < ncomp:
+        raise ValueError(f"{where}: component={component} is out of range; array {label!r} has {ncomp} "
+                         f"components (0..{ncomp - 1}).")
+    return arr[..., int(component)]
+
+
+def from_array(arr: np.ndarray, spacing, origin, component, where: str) -> VolumeSamples:
+    """Check a numpy array ``values[k, j, i]`` (or ``[k, j, i, c]`` with ``component=``) and wrap it.
+
+    Parameters
+    ----------
+    arr : ndarray
+        3-D samples, or 4-D with the components last.
+    spacing, origin : (3,) tuples or None
+        Checked already; None gives ``(1, 1, 1)`` and ``(0, 0, 0)``.
+    component : None, int or "magnitude"
+        See :func:`pick_component`.
+    where : str
+        The source, for the messages.
+
+    Returns
+    -------
+    VolumeSamples
+    """
+    check_samples(arr, where)
+    if arr.ndim == 4:
+        arr = pick_component(arr, arr.shape[3], "the last axis", where, component)
+    elif component is not None:
+        raise ValueError(f"{where}: component= applies to multi-component data; this array has shape {arr.shape}.")
+    if arr.ndim != 3:
+        hint = (" A 2-D image is a height field: use splinevis.io.read_heights." if arr.ndim == 2 else
+                " A 4-D array (nz, ny, nx, c) is read with component=." if arr.ndim > 4 else "")
+        raise ValueError(f"{where}: volume samples must be a 3-D array (nz, ny, nx), got shape {arr.shape}.{hint}")
+    check_size(arr.shape, where)
+    return VolumeSamples(values=arr, spacing=spacing or (1.0, 1.0, 1.0), origin=origin or (0.0, 0.0, 0.0),
+                         source=where)
+
+
+def axis_signs(direction: np.ndarray, where: str) -> np.ndarray:
+    """+-1 per axis when ``direction`` is diagonal with entries +-1 (to rounding); else ValueError.
+
+    Parameters
+    ----------
+    direction : (3, 3) array_like
+        A direction matrix (columns: the world direction of each index axis).
+    where : str
+        The source, for the message.
+
+    Returns
+    -------
+    (3,) ndarray of float64
+        -1 for a flipped axis, +1 otherwise.
+
+    Raises
+    ------
+    ValueError
+        A rotation, shear or axis permutation: the spline schemes need axis-aligned grids.
+    """
+    d = np.asarray(direction, dtype=np.float64)
+    if d.shape != (3, 3) or not np.isfinite(d).all():
+        raise ValueError(f"{where}: direction matrix {d.tolist()} is not a finite 3 x 3 matrix.")
+    off = d - np.diag(np.diag(d))
+    diag = np.diag(d)
+    if np.abs(off).max() <= 1e-9 and np.all(np.abs(np.abs(diag) - 1.0) <= 1e-9):
+        return np.sign(diag)
+    perm = np.all(np.abs(np.round(d) - d) <= 1e-9) and np.all(np.abs(np.round(d)).sum(axis=0) == 1) and \
+        np.all(np.abs(np.round(d)).sum(axis=1) == 1)
+    what = "permutes the axes" if perm else "is not axis-aligned (a rotation or shear)"
+    raise ValueError(f"{where}: the direction matrix {np.round(d, 12).tolist()} {what}; only axis-aligned "
+                     "grids (the identity up to axis flips, i.e. diagonal +-1) are supported, and dropping the "
+                     "direction would draw a wrong picture. Resample onto an axis-aligned grid first "
+                     "(e.g. in 3D Slicer or SimpleITK), or set the direction to the identity if you know the "
+                     "orientation does not matter.")
