@@ -106,7 +106,7 @@ class Plotter(pv.Plotter):
             from .gl.mesh_effects import add_mesh_with_effects
 
             return add_mesh_with_effects(self, built, st, name=name)
-        spline = SplineActor(built, st, self.renderer)
+        spline = SplineActor(built, st, self.renderer, kind=program.kind)
         spline.model = model
         spline.program = program
         self.add_actor(spline.actor, name=name, reset_camera=True)

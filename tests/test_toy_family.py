@@ -88,3 +88,38 @@ def test_every_builtin_program_follows_the_contract():
         assert p.signature_problems() == [], p.name
         assert p.kind in ("raycast", "surface", "passes", "mesh")
         assert p.hard_cases is not None and len(p.hard_cases()) >= 3, p.name
+
+
+def test_toy_surface_family_evaluates_per_fragment():
+    # The "surface" kind: the fragment evaluates S(u, v) at the interpolated parameters and writes its depth.
+    # For a parallelogram the mesh is the surface, so the depth buffer must equal the float64 window depth of
+    # the plane hit of every pixel's ray (within float32 arithmetic on coordinates of size ~2: 1e-6) and the
+    # normals output must show the plane's normal.
+    from splinevis.gl.camera import pixel_rays, window_depth
+
+    from toy_family import SURFACE, ToyPlane
+
+    programs.register(SURFACE)
+    try:
+        plane = ToyPlane()
+        pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+        actor = pl.add_spline(plane, output="normals")
+        pl.camera_position = [(2.0, -3.0, 3.0), (0.0, 0.0, 0.2), (0, 0, 1)]
+        pl.reset_camera_clipping_range()
+        img = pl.screenshot().astype(float) / 255
+        depth = pl.depth_buffer()
+        matrix = pl.camera_matrix()
+        pl.close()
+    finally:
+        programs.unregister(SURFACE.name)
+    assert actor.kind == "surface" and "sv_surface_eval" in actor.program_sources["fragment"]
+    o, d = pixel_rays(matrix, 160, 120)
+    n = np.cross(plane.e1, plane.e2)
+    t = ((plane.p0 - o) @ n) / (d @ n)
+    ref = window_depth(matrix, o + t[..., None] * d)
+    drawn = depth < 1
+    assert drawn.sum() > 3000
+    assert np.abs(depth[drawn] - ref[drawn]).max() < 1e-5
+    unit = n / np.linalg.norm(n)
+    expected = 0.5 * (unit + 1)  # normal-colour convention of lib/effects/normals.glsl (faces the viewer here)
+    assert np.abs(img[drawn] - expected).max() < 2.5 / 255

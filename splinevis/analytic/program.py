@@ -103,15 +103,6 @@ def hard_cases() -> list:
 
 
 PROGRAM = SplineProgram(
-    name="analytic_patch",
-    kind="raycast",
-    model_type=QuarticTrianglePatch,
-    build=patch_program,
-    reference=_reference,
-    depth_bound=patch_depth_bound,
-    hard_cases=hard_cases,
-    root_methods=ROOTS,
-    newton_iterations=8,
-    options=("coefficients_in", "roots"),
-    description="one quartic BB triangle patch z = f(x, y), ray-cast on a prism",
-)
+    "analytic_patch", "raycast", QuarticTrianglePatch, patch_program, reference=_reference,
+    depth_bound=patch_depth_bound, hard_cases=hard_cases, root_methods=ROOTS, newton_iterations=8,
+    options=("coefficients_in", "roots"), description="one quartic BB triangle patch z = f(x, y), ray-cast on a prism")

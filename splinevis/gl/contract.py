@@ -13,7 +13,9 @@ Kinds (how the pixels are made):
     :class:`~splinevis.gl.spec.ProgramSpec` whose entry defines ``sv_surface_hit``): terrains, volumes.
 ``surface``
     A mesh carrying surface parameters is rasterized and every fragment evaluates the surface exactly at its
-    parameters (``build`` returns a ProgramSpec whose entry defines ``sv_surface_eval``): NURBS.
+    parameters (``build`` returns a ProgramSpec whose entry defines
+    ``bool sv_surface_eval(vec3 pos_mc, out SvHit hit)`` reading its parameters from varyings; the mesh is
+    drawn from both sides): NURBS. ``tests/toy_family`` has a working example.
 ``passes``
     A chain of render-to-texture passes (:mod:`splinevis.gl.passes`) computes the geometry; ``build``
     returns a PyVista dataset (or a texture on one) that is drawn as a mesh: smooth geometry images.

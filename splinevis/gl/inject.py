@@ -55,8 +55,22 @@ _FS_DEPTH = """
   gl_FragDepth = sv_hit.depth;
   vec4 sv_out = sv_shade(sv_hit, sv_rd);
 """
+# The "surface" kind: the rasterized mesh carries surface parameters; the program's sv_surface_eval evaluates
+# the surface exactly at this fragment's parameters (no ray search). The view ray of the fragment still
+# decides two-sided shading and reflections.
+_FS_SURFACE = """
+  vec3 sv_ro; vec3 sv_rd; float sv_tmin;
+  sv_pixel_ray(svPosMC, sv_ro, sv_rd, sv_tmin);
+  SvHit sv_hit;
+  if (!sv_surface_eval(svPosMC, sv_hit)) discard;
+  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_hit.pos);
+  gl_FragDepth = sv_hit.depth;
+  vec4 sv_out = sv_shade(sv_hit, sv_rd);
+"""
 _FS_LIGHT = """  fragOutput0 = sv_out;
 """
+#: Fragment code per program kind (splinevis.gl.contract.KINDS) that becomes a SplineActor.
+_FS_IMPL = {"raycast": _FS_DEPTH, "surface": _FS_SURFACE}
 
 
 def _set_uniform(program, name: str, value) -> None:
@@ -192,7 +206,8 @@ class SplineActor:
         Addresses of the vtkShaderProgram objects used; equal ids mean a shared compiled program.
     """
 
-    def __init__(self, spec: ProgramSpec, style: Style, renderer=None, *, cull_front: bool = True):
+    def __init__(self, spec: ProgramSpec, style: Style, renderer=None, *, cull_front: bool | None = None,
+                 kind: str = "raycast"):
         from vtkmodules.vtkCommonCore import vtkCommand
         from vtkmodules.vtkCommonDataModel import vtkPolyData
         from vtkmodules.vtkRenderingCore import vtkActor
@@ -234,7 +249,12 @@ class SplineActor:
         self.offset = np.asarray(spec.offset, dtype=np.float64).reshape(3)
         actor.SetPosition(*self.offset.tolist())
         prop = actor.GetProperty()
-        if cull_front:
+        if kind not in _FS_IMPL:
+            raise ValueError(f"a SplineActor draws programs of kind {' or '.join(_FS_IMPL)}, not {kind!r}.")
+        self.kind = kind
+        # a ray-cast proxy is drawn from its far side (the camera may be inside it); a surface mesh is the
+        # surface itself: both sides drawn
+        if cull_front if cull_front is not None else kind == "raycast":
             prop.FrontfaceCullingOn()
         if style.opacity < 1:
             prop.SetOpacity(float(style.opacity))
@@ -242,7 +262,7 @@ class SplineActor:
         sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
         sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)
         sp.AddFragmentShaderReplacement(_FS_DEC_TAG, True, fs_dec + self.assembled.text, False)
-        sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, _FS_DEPTH, False)
+        sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, _FS_IMPL[kind], False)
         sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
         self._textures = {}
         for name, arr in spec.textures.items():

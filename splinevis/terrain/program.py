@@ -15,7 +15,9 @@ from ..gl.contract import SplineProgram
 from ..gl.error_bounds import model_frame_matrix, ray_depth_error_bound
 from ..gl.proxies import boxes, pack_rgba32f
 from ..gl.spec import ProgramSpec
+from .hard_cases import hard_cases
 from .model import TerrainSpline
+from .raycast import raycast_terrain
 
 __all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "terrain_depth_bound", "PROGRAM"]
 
@@ -134,34 +136,13 @@ def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t) 
                                  o_mc, directions, t, coord, proxy_size=float(max(x1 - x0, y1 - y0, np.ptp(terrain.zrange))))
 
 
-def _reference(terrain, origins, directions, tmin=0.0, *, method="reference", iterations=8):
-    from .raycast import raycast_terrain
-
-    return raycast_terrain(terrain, origins, directions, tmin, method=method, iterations=iterations)
-
-
 def _model_from(heights, scheme: str = "C1", **read_options) -> TerrainSpline:
     """A TerrainSpline from anything :func:`splinevis.io.read_heights` reads, or a HeightGrid."""
     return TerrainSpline.from_heights(heights, scheme, **read_options)
 
 
-def _hard_cases():
-    from .hard_cases import hard_cases
-
-    return hard_cases()
-
-
 PROGRAM = SplineProgram(
-    name="terrain",
-    kind="raycast",
-    model_type=TerrainSpline,
-    build=terrain_program,
-    reference=_reference,
-    depth_bound=terrain_depth_bound,
-    hard_cases=_hard_cases,
-    model_from=_model_from,
-    root_methods=ROOTS,
-    newton_iterations=8,
+    "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
+    hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
     options=("max_steps", "hierarchy", "roots"),
-    description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree",
-)
+    description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")

@@ -24,14 +24,16 @@ import numpy as np
 
 from .._validation import check_choice, check_degree
 from ..bb.root_options import check_root_method, root_defines
-from ..gl.contract import RayHits, SplineProgram
+from ..gl.contract import SplineProgram
 from ..gl.error_bounds import isosurface_depth_error_bound, model_frame_matrix
 from ..gl.proxies import box_triangles, pack_rgba32f
 from ..gl.spec import ProgramSpec
 from ..hierarchy.culling import FrustumCuller
+from .hard_cases import hard_cases
 from .isosurface import Isosurface, value_reference
 from .model import Relevant, VolumeSpline
 from .proxies import BLOCK_SIZE, proxy_geometry, proxy_units
+from .raycast import raycast_isosurface
 from .tables import coefficient_table, data_texture, determining_table, mask_texture
 
 __all__ = ["Isosurface", "isosurface_program", "set_isovalue", "isosurface_depth_bound", "attach_culling",
@@ -194,12 +196,6 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
                                         float(np.abs(b).max()), sp.degree)
 
 
-def _reference(model: Isosurface, origins, directions, tmin=0.0, *, method="reference", iterations=6) -> RayHits:
-    from .raycast import raycast_isosurface
-
-    return raycast_isosurface(model, origins, directions, tmin, method=method, iterations=iterations)
-
-
 def _model_from(volume, isovalue, scheme="quadratic", **read_options) -> Isosurface:
     """An :class:`Isosurface` of a VolumeSpline, a VolumeGrid or anything :func:`splinevis.io.read_volume`
     reads (``scheme`` and ``read_options`` are ignored for a VolumeSpline)."""
@@ -228,24 +224,8 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
     actor.culler.attach(plotter.renderer)
 
 
-def _hard_cases():
-    from .hard_cases import hard_cases
-
-    return hard_cases()
-
-
 PROGRAM = SplineProgram(
-    name="isosurface",
-    kind="raycast",
-    model_type=Isosurface,
-    build=isosurface_program,
-    reference=_reference,
-    depth_bound=isosurface_depth_bound,
-    hard_cases=_hard_cases,
-    model_from=_model_from,
-    on_add=attach_culling,
-    root_methods=ROOTS,
-    newton_iterations=6,
-    options=("encoding", "roots", "color_field", "proxy", "block_size"),
-    description="isosurface of a trivariate spline on the type-6 partition, ray-cast in relevant cubes",
-)
+    "isosurface", "raycast", Isosurface, isosurface_program, reference=raycast_isosurface,
+    depth_bound=isosurface_depth_bound, hard_cases=hard_cases, model_from=_model_from, on_add=attach_culling,
+    root_methods=ROOTS, newton_iterations=6, options=("encoding", "roots", "color_field", "proxy", "block_size"),
+    description="isosurface of a trivariate spline on the type-6 partition, ray-cast in relevant cubes")

@@ -93,3 +93,23 @@ def tessellate(model, style, *, newton_iterations, resolution=32):
 
 MESH = SplineProgram(name="toy_mesh_sphere", kind="mesh", model_type=ToyMeshSphere, build=tessellate,
                      options=("resolution",), description="a sphere, tessellated on the CPU")
+
+
+class ToyPlane:
+    """The parallelogram ``p0 + u e1 + v e2``, (u, v) in [0, 1]^2: a "surface"-kind toy."""
+
+    def __init__(self, p0=(-1.0, -1.0, 0.0), e1=(2.0, 0.0, 0.5), e2=(0.0, 2.0, 0.25)):
+        self.p0, self.e1, self.e2 = (np.asarray(v, dtype=np.float64) for v in (p0, e1, e2))
+
+
+def build_plane(model, style, *, newton_iterations):
+    uv = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    points = model.p0 + uv[:, :1] * model.e1 + uv[:, 1:] * model.e2
+    return ProgramSpec(name="toy_plane", entry="toy_plane.glsl", points=points, triangles=np.array([[0, 1, 2], [0, 2, 3]]),
+                       uniforms={"sv_toy_p0": tuple(model.p0), "sv_toy_e1": tuple(model.e1),
+                                 "sv_toy_e2": tuple(model.e2), "sv_scalar_range": (-1.0, 1.0)},
+                       varyings={"sv_uv": uv}, glsl_roots=(GLSL,))
+
+
+SURFACE = SplineProgram(name="toy_plane", kind="surface", model_type=ToyPlane, build=build_plane,
+                        description="a parallelogram evaluated per fragment")
