@@ -114,8 +114,11 @@ class Plotter(pv.Plotter):
         return spline
 
     def add_terrain(self, heights, scheme: str = "C1", style: Style | None = None, *, read_options: dict | None = None,
-                    **options):
+                    presmooth: int = 0, **options):
         """Build a terrain spline from height data and add it (see :meth:`add_spline` for ``options``).
+
+        ``presmooth`` > 0 smooths noisy heights first with that many GPU passes of a binomial filter
+        (:func:`splinevis.terrain.prefilter.smooth_heights`).
 
         ``heights`` is anything :func:`splinevis.io.read_heights` reads (2-D array, pyvista grid, VTK
         file, USGS DEM, GeoTIFF) or a :class:`~splinevis.io.HeightGrid`; ``scheme`` one of
@@ -132,7 +135,7 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
-        return self._add_from("terrain", (heights, scheme), read_options, style, options)
+        return self._add_from("terrain", (heights, scheme, presmooth), read_options, style, options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,

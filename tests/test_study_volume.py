@@ -12,6 +12,8 @@ import pytest
 
 from datasets_synthetic.volumes import torus_distance
 from splinevis.studies import volume as V
+from splinevis.studies import volume_accuracy as A
+from splinevis.studies.report import clean
 
 WINDOW = (160, 120)
 
@@ -23,7 +25,7 @@ def ref():
 
 
 def test_unproject_inverts_window_depth(ref):
-    from splinevis.analysis.rays import window_depth
+    from splinevis.gl.camera import window_depth
 
     pts = ref.points.copy()
     depth = np.where(ref.covered, window_depth(ref.matrix, pts), 1.0)
@@ -36,11 +38,11 @@ def test_two_sided_lighting_normals_are_recovered():
     rng = np.random.default_rng(0)
     n = rng.normal(size=(2000, 3))
     n /= np.linalg.norm(n, axis=1, keepdims=True)
-    intensity = np.abs(n @ V._LIGHTS.T)
+    intensity = np.abs(n @ A._LIGHTS.T)
     got = V.normals_from_two_sided(intensity)
-    assert V._angles(got, n).max() < 1e-4  # exact inputs (arccos near 1 resolves ~1e-6 degrees): the sign pattern is recovered up to the global sign
+    assert A._angles(got, n).max() < 1e-4  # exact inputs (arccos near 1 resolves ~1e-6 degrees): the sign pattern is recovered up to the global sign
     q = np.round(intensity * 255) / 255  # 8-bit: the components are off by <= 1/510, about 0.1 degree
-    assert np.median(V._angles(V.normals_from_two_sided(q), n)) < 0.3
+    assert np.median(A._angles(V.normals_from_two_sided(q), n)) < 0.3
 
 
 @pytest.mark.gl
@@ -73,7 +75,7 @@ def test_methods_on_the_torus(ref):
     # VTK's volume: no depth, normals read back from 8-bit renders: above the read-out floor, below a few degrees
     assert vtk["position_err_median_h"] is None
     assert vtk["quantisation_floor_median_deg"] < vtk["normal_err_median_deg"] < 5.0
-    json.dumps(V._clean([mc, sp, vtk]), allow_nan=False)
+    json.dumps(clean([mc, sp, vtk]), allow_nan=False)
 
 
 def test_approximation_and_memory_rows():
@@ -104,10 +106,10 @@ def test_report_is_nan_free_json_and_markdown():
                                     "coverage_mismatch": 0, "position_err_median_h": None,
                                     "normal_err_median_deg": math.inf}],
               "memory": [], "paper_table_1": V.PAPER_TABLE_1}
-    clean = V._clean(result)
-    text = json.dumps(clean, allow_nan=False)
+    cleaned = clean(result)
+    text = json.dumps(cleaned, allow_nan=False)
     assert "NaN" not in text and "Infinity" not in text
-    md = V._markdown(clean)
+    md = V._markdown(cleaned)
     assert "cubic scheme NOT available" in md and "### paper" in md
 
 

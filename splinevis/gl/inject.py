@@ -95,27 +95,12 @@ def _set_uniform(program, name: str, value) -> None:
 
 
 def _float_texture(array: np.ndarray, name: str):
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkRenderingCore import vtkTexture
+    """An RGBA32F table as a VTK texture sharing the array's memory (:func:`splinevis.gl.textures.to_vtk_texture`)."""
+    from .textures import to_vtk_texture
 
-    arr = np.ascontiguousarray(array, dtype=np.float32)
-    if arr.ndim != 3 or arr.shape[2] != 4:
-        raise ValueError(f"texture {name} must be (H, W, 4) float32, got {arr.shape}.")
-    h, w, _ = arr.shape
-    img = vtkImageData()
-    img.SetDimensions(w, h, 1)
-    vtk_arr = numpy_to_vtk(arr.reshape(-1, 4), deep=True)
-    vtk_arr.SetName(name)
-    img.GetPointData().SetScalars(vtk_arr)
-    tex = vtkTexture()
-    tex.SetInputData(img)
-    tex.SetColorModeToDirectScalars()  # keep float values: an RGBA32F texture
-    tex.InterpolateOff()
-    tex.MipmapOff()
-    tex.RepeatOff()
-    tex.EdgeClampOn()
-    return tex
+    if np.ndim(array) != 3 or np.shape(array)[2] != 4:
+        raise ValueError(f"texture {name} must be (H, W, 4) float32, got {np.shape(array)}.")
+    return to_vtk_texture(array, name=name)
 
 
 def _image_texture(image: np.ndarray, *, interpolate: bool, repeat: bool = False):

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .report import progress_bar, pyplot, save_figure
+
 __all__ = ["render_showcase", "composite_scene", "EFFECT_PANELS"]
 
 CAMERA = [(2.5, -3.3, 2.4), (0.05, -0.1, 0.05), (0.0, 0.0, 1.0)]
@@ -78,18 +80,13 @@ def composite_scene(window_size=(640, 480), style=None, sphere=True):
 
 def render_showcase(out_dir, *, progress=True) -> dict:
     """Render every showcase figure into ``out_dir``; returns {name: path}."""
-    import matplotlib
+    from ..analysis.composite import UNLIT, front_surface_agreement
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from tqdm import tqdm
-
-    from ..analysis.composite import front_surface_agreement
-
+    plt = pyplot()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _effect_panels()
-    steps = tqdm(total=4 + len(panels), desc="showcase", disable=not progress, unit="fig")
+    steps = progress_bar(total=4 + len(panels), desc="showcase", enabled=progress, unit="fig")
     written = {}
 
     pl, patch, _ = composite_scene()
@@ -100,7 +97,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     written["composite"] = path
     steps.update()
 
-    result = front_surface_agreement(window_size=(640, 480))
+    result = front_surface_agreement(*composite_scene((640, 480), style=UNLIT)[:2])
     from matplotlib.colors import ListedColormap
 
     classes = ListedColormap(["white", "firebrick", "royalblue"])  # background, patch, sphere
@@ -114,11 +111,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
                       f"({100 * result['agreement']:.3f}% agree)")
     for ax in axes:
         ax.set_axis_off()
-    fig.tight_layout()
-    path = out / "composite_check.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    written["composite_check"] = path
+    written["composite_check"] = save_figure(fig, out / "composite_check.png", dpi=110)
     steps.update()
 
     images = []
@@ -135,16 +128,12 @@ def render_showcase(out_dir, *, progress=True) -> dict:
         ax.set_title(title, fontsize=10)
     for ax in axes.ravel():
         ax.set_axis_off()
-    fig.tight_layout()
-    path = out / "effects.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    written["effects"] = path
+    written["effects"] = save_figure(fig, out / "effects.png", dpi=110)
     path = out / "terrain.png"
     _terrain_figure(path)
     written["terrain"] = path
     steps.update()
-    from .volume import side_by_side_figure
+    from .volume_figures import side_by_side_figure
 
     path = out / "volume.png"
     side_by_side_figure(path)
@@ -155,7 +144,6 @@ def render_showcase(out_dir, *, progress=True) -> dict:
 
 
 def _terrain_figure(path):
-    import matplotlib.pyplot as plt
     from scipy.ndimage import gaussian_filter
 
     from datasets_synthetic.dem_files import fractal_terrain
@@ -164,7 +152,7 @@ def _terrain_figure(path):
 
     heights = 400.0 + 300.0 * gaussian_filter(fractal_terrain(65, seed=7, hurst=0.9), 1.5, mode="wrap")
     grid = read_heights(heights, spacing=(60.0, 60.0), origin=(500_010.0, 5_100_020.0))
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, axes = pyplot().subplots(1, 3, figsize=(15, 4.6))
     for ax, scheme in zip(axes, ("linear", "C2", "C1")):
         pl = Plotter(off_screen=True, window_size=(600, 440))
         pl.set_background("white")
@@ -180,6 +168,4 @@ def _terrain_figure(path):
         ax.set_title(f"{scheme}: {actor.model.num_patches:,} patches, reflection lines", fontsize=10)
         ax.set_axis_off()
     fig.suptitle("65x65 DEM at UTM (500010, 5100020), every pixel ray-cast on the spline", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -3,9 +3,9 @@
 Writes ``DIR/terrain.json`` and figures:
 
 * ``accuracy_table.md`` -- relative RMS and max errors on Franke's function per scheme and data size over
-  >= 1e5 random sites (paper 000, Table I; the paper's legible values as a labelled column "paper");
+  >= 1e5 random sites ([Reis2008, Table I]; the paper's legible values as a labelled column "paper");
 * ``comparison_normals_shading_lines.png`` -- colour-coded normals, shading and reflection lines for
-  linear vs C0/C1/C2 at the same data count, and a linear mesh with 25x the data (paper Figs. 14-16);
+  linear vs C0/C1/C2 at the same data count, and a linear mesh with 25x the data ([Reis2008, Figs. 14-16]);
 * ``pareto.png`` + ``pareto.md`` -- per-pixel normal-angle error against the analytic surface vs frame
   time, for PyVista meshes from coarse to millions of triangles and for every spline scheme at root
   iteration counts 1..6; where the spline becomes cheaper than a mesh of the same accuracy;
@@ -16,23 +16,26 @@ Accuracy of what is *shown*: normal errors are computed with the float64 twins o
 spline ray caster at the same iteration count, the mesh's interpolated vertex normals at its exact
 ray hit), on a random subset of pixels; the tests prove the GPU matches these twins per pixel. Frame
 times are measured on the GPU (llvmpipe here), anti-aliasing off, min and median of repeated frames.
+
+Tables, JSON, timing rows and figures are written with the helpers of :mod:`splinevis.studies.report`.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
 
 import numpy as np
 
+from .report import error_summary, md_table, paper_columns, progress_bar, pyplot, save_figure, timed, write_json
+
 __all__ = ["run_terrain_study", "accuracy_table", "PAPER_TABLE_I"]
 
 WINDOW = (800, 600)
 CAMERA = [(-0.35, -0.75, 1.55), (0.5, 0.48, 0.25), (0.0, 0.0, 1.0)]
 
-#: Paper 000, Table I, row "144 data points" (the only row fully legible in the text extraction):
+#: [Reis2008, Table I], row "144 data points" (the only row fully legible in the text extraction):
 #: (relative RMS, relative max) per method. Shown only in the column labelled "paper".
 PAPER_TABLE_I = {
     ("C2", 144): (7.9e-3, 2.9e-2),
@@ -94,7 +97,7 @@ def _true_normals(points):
 
 def _camera_rays(pixels, seed=1):
     """The study camera's rays through a random subset of pixels (float64)."""
-    from ..analysis.rays import pixel_rays
+    from ..gl.camera import pixel_rays
     from ..plotting import Plotter
 
     pl = Plotter(off_screen=True, window_size=WINDOW)
@@ -113,9 +116,9 @@ def _camera_rays(pixels, seed=1):
 
 def spline_normal_error(terrain, o, d, iterations):
     """Normal-angle errors (degrees) the ray-cast spline shows at the given iteration count."""
-    from ..terrain.raycast import raycast_terrain
+    from ..programs import program_for
 
-    hits = raycast_terrain(terrain, o, d, 0.0, method="gpu", iterations=iterations)
+    hits = program_for(terrain).raycast(terrain, o, d, method="bracketed", iterations=iterations)
     h = hits.hit
     return _normal_angles(hits.normals[h], _true_normals(hits.points[h]))
 
@@ -124,8 +127,8 @@ def mesh_normal_error(n, o, d):
     """Normal-angle errors (degrees) of a PyVista mesh of Franke's function with n x n vertices, smooth
     shading: the pixel shows the barycentric interpolation of the vertex normals (VTK averages the unit
     normals of the faces around a vertex) at the ray's hit on the triangles."""
+    from ..programs import program_for
     from ..terrain.model import cell_barycentric
-    from ..terrain.raycast import raycast_terrain
 
     terrain = franke_terrain(n, "linear")
     franke, _ = _franke()
@@ -144,7 +147,7 @@ def mesh_normal_error(n, o, d):
         for dj, di in corners:
             vn[dj: dj + n - 1, di: di + n - 1] += face
     vn /= np.linalg.norm(vn, axis=-1, keepdims=True)
-    hits = raycast_terrain(terrain, o, d, 0.0)
+    hits = program_for(terrain).raycast(terrain, o, d)
     hit = hits.hit
     p = hits.points[hit]
     u, v = p[:, 0] / h, p[:, 1] / h
@@ -158,13 +161,6 @@ def mesh_normal_error(n, o, d):
     b = np.where(tri[:, None] == 0, vn[j, i + 1], vn[j + 1, i])  # T0: (i+1, j); T1: (i, j+1)
     shown = lam[:, :1] * a + lam[:, 1:2] * np.where(tri[:, None] == 0, b, c) + lam[:, 2:] * np.where(tri[:, None] == 0, c, b)
     return _normal_angles(shown, _true_normals(p))
-
-
-def _frame_times(pl, repeats):
-    from ..analysis.timing import frame_times
-
-    r = frame_times(pl, repeats)
-    return r["min_ms"], r["median_ms"]
 
 
 def _scene_spline(terrain, iterations, style=None):
@@ -195,8 +191,6 @@ def _scene_mesh(n):
 
 def accuracy_vs_time(*, quick=False, repeats=5, pixels=20_000, progress=True):
     """Rows (kind, config, triangles/patches, frame ms, normal error median/p95 in degrees)."""
-    from tqdm import tqdm
-
     o, d = _camera_rays(pixels)
     mesh_sizes = [17, 33, 65, 129, 257] + ([] if quick else [513, 1025])
     schemes = ["linear", "C0", "C1", "C2", "C2-cubic"]
@@ -205,28 +199,26 @@ def accuracy_vs_time(*, quick=False, repeats=5, pixels=20_000, progress=True):
     jobs = [("mesh", n, None) for n in mesh_sizes] + [("spline", s, k) for s in schemes for k in iterations]
     rows = []
     terrains = {s: franke_terrain(data_n, s) for s in schemes}
-    for kind, a, b in tqdm(jobs, desc="accuracy vs time", disable=not progress):
+    for kind, a, b in progress_bar(jobs, "accuracy vs time", enabled=progress):
         if kind == "mesh":
             pl, ntri = _scene_mesh(a)
-            tmin, tmed = _frame_times(pl, repeats)
+            frames = timed(pl, repeats, with_repeats=False)
             pl.close()
             err = mesh_normal_error(a, o, d)
             rows.append({"kind": "PyVista mesh", "config": f"{a}x{a} vertices", "elements": int(ntri),
-                         "frame_min_ms": tmin, "frame_median_ms": tmed, **_stats(err)})
+                         **frames, **_stats(err)})
         else:
             pl = _scene_spline(terrains[a], b)
-            tmin, tmed = _frame_times(pl, repeats)
+            frames = timed(pl, repeats, with_repeats=False)
             pl.close()
             err = spline_normal_error(terrains[a], o, d, b)
             rows.append({"kind": f"spline {a}", "config": f"{data_n}x{data_n} data, {b} iterations",
-                         "elements": terrains[a].num_patches, "iterations": b,
-                         "frame_min_ms": tmin, "frame_median_ms": tmed, **_stats(err)})
+                         "elements": terrains[a].num_patches, "iterations": b, **frames, **_stats(err)})
     return rows
 
 
 def _stats(err):
-    return {"normal_err_median_deg": float(np.median(err)), "normal_err_p95_deg": float(np.percentile(err, 95)),
-            "normal_err_max_deg": float(err.max()), "pixels": int(err.size)}
+    return {**error_summary(err, "normal", "deg"), "pixels": int(err.size)}
 
 
 def crossover(rows):
@@ -289,24 +281,20 @@ def scaling(repeats=5, sizes=(65, 1025)):
         pl.add_spline(t, lights=1)
         pl.camera_position = [(0.5, -0.35, 0.55), (0.5, 0.45, 0.0), (0, 0, 1)]
         pl.camera.clipping_range = (0.01, 10.0)
-        tmin, tmed = _frame_times(pl, repeats)
+        frames = timed(pl, repeats, with_repeats=False)
         covered = float((pl.depth_buffer() < 1.0).mean())
         pl.close()
-        rows.append({"grid": f"{n}x{n}", "patches": t.num_patches, "frame_min_ms": tmin, "frame_median_ms": tmed,
-                     "screen_covered": covered})
+        rows.append({"grid": f"{n}x{n}", "patches": t.num_patches, **frames, "screen_covered": covered})
     rows.append({"ratio_largest_to_smallest": rows[-1]["frame_median_ms"] / rows[0]["frame_median_ms"]})
     return rows
 
 
 def comparison_figure(path, *, n=13, fine_factor=5):
     """Normals, shading and reflection lines for linear vs C0/C1/C2 at n x n data, and linear at
-    (fine_factor (n-1) + 1)^2 data (fine_factor 5: 25x the cells, about 22x the samples) -- paper Figs. 14-16."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    (fine_factor (n-1) + 1)^2 data (fine_factor 5: 25x the cells, about 22x the samples) -- [Reis2008, Figs. 14-16]."""
     from ..plotting import Plotter
+
+    plt = pyplot()
 
     columns = [("linear", n), ("C0", n), ("C1", n), ("C2", n), ("linear", fine_factor * (n - 1) + 1)]
     rows = [("normals", dict(output="normals")), ("shading", dict(lights=2, specular=True)),
@@ -327,17 +315,13 @@ def comparison_figure(path, *, n=13, fine_factor=5):
                 axes[ri, ci].set_title(f"{scheme}, {m}x{m} data", fontsize=10)
         for ri, (rname, _) in enumerate(rows):
             axes[ri, 0].text(-0.05, 0.5, rname, transform=axes[ri, 0].transAxes, rotation=90, va="center", ha="right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def pareto_figure(rows, path):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Median normal error against median frame time: the meshes as one curve, each spline scheme over its
+    iteration counts, from :func:`accuracy_vs_time`."""
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 5.5))
     mesh = [r for r in rows if r["kind"] == "PyVista mesh"]
     ax.plot([r["frame_median_ms"] for r in mesh], [r["normal_err_median_deg"] for r in mesh], "k-o", label="PyVista mesh (smooth shading)")
@@ -354,81 +338,66 @@ def pareto_figure(rows, path):
     ax.set_title("Accuracy vs time: ray-cast splines vs triangle meshes")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def _md_table(rows, cols, fmt):
-    head = "| " + " | ".join(c[0] for c in cols) + " |\n|" + "|".join("---" for _ in cols) + "|\n"
-    body = ""
-    for r in rows:
-        body += "| " + " | ".join(fmt(r.get(c[1]), c[2]) for c in cols) + " |\n"
-    return head + body
-
-
-def _fmt(v, kind):
-    if v is None:
-        return "-"
-    if kind == "e":
-        return f"{v:.2e}"
-    if kind == "f1":
-        return f"{v:.1f}"
-    if kind == "f2":
-        return f"{v:.2f}"
-    if kind == "int":
-        return f"{int(v):,}"
-    return str(v)
+    save_figure(fig, path, dpi=110)
 
 
 def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
-    """Run the study; returns the dict also written to ``out_dir/terrain.json``."""
+    """Run the study; returns the dict also written to ``out_dir/terrain.json``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Created if missing; receives ``terrain.json``, the markdown tables and the figures.
+    quick : bool, optional
+        Smaller sizes and fewer configurations (a few minutes).
+    progress : bool, optional
+        Progress bars on stderr.
+
+    Returns
+    -------
+    dict
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     result = {"quick": quick}
     sizes = (13, 25, 49) if quick else (13, 25, 49, 97)
     result["accuracy"] = accuracy_table(sizes=sizes, sites=100_000)
     (out / "accuracy_table.md").write_text(
-        "# Franke's function: relative errors over 100,000 random sites\n\n" + _md_table(
+        "# Franke's function: relative errors over 100,000 random sites\n\n" + md_table(
             result["accuracy"],
             [("scheme", "scheme", "s"), ("grid", "grid", "s"), ("data", "data_points", "int"), ("patches", "patches", "int"),
-             ("rms (rel)", "rms_rel", "e"), ("max (rel)", "max_rel", "e"), ("paper rms", "paper_rms_rel", "e"),
-             ("paper max", "paper_max_rel", "e")], _fmt)
-        + "\n'paper' = paper 000 Table I at 144 data points (12x12); our grids have n x n points with n = 4k+1 so the C0 "
+             ("rms (rel)", "rms_rel", "e"), ("max (rel)", "max_rel", "e")]
+            + paper_columns([("rms", "paper_rms_rel", "e"), ("max", "paper_max_rel", "e")]))
+        + "\n'paper' = [Reis2008, Table I] at 144 data points (12x12); our grids have n x n points with n = 4k+1 so the C0 "
           "scheme's 4x4 macro cells fit; the 13x13 row is the nearest size.\n")
     comparison_figure(out / "comparison_normals_shading_lines.png")
     result["accuracy_vs_time"] = accuracy_vs_time(quick=quick, progress=progress)
     result["crossover"] = crossover(result["accuracy_vs_time"])
     pareto_figure(result["accuracy_vs_time"], out / "pareto.png")
     (out / "pareto.md").write_text(
-        "# Accuracy vs time\n\n" + _md_table(
+        "# Accuracy vs time\n\n" + md_table(
             result["accuracy_vs_time"],
             [("renderer", "kind", "s"), ("config", "config", "s"), ("triangles/patches", "elements", "int"),
              ("frame min ms", "frame_min_ms", "f1"), ("frame median ms", "frame_median_ms", "f1"),
-             ("normal err median °", "normal_err_median_deg", "e"), ("p95 °", "normal_err_p95_deg", "e")], _fmt)
-        + "\n## Where the spline becomes cheaper\n\n" + _md_table(
+             ("normal err median °", "normal_err_median_deg", "e"), ("p95 °", "normal_err_p95_deg", "e")])
+        + "\n## Where the spline becomes cheaper\n\n" + md_table(
             result["crossover"],
             [("spline", "spline", "s"), ("iterations", "iterations", "s"), ("spline ms", "spline_ms", "f1"),
              ("normal err °", "normal_err_median_deg", "e"), ("mesh ms for same error", "mesh_ms_for_same_error", "f1"),
              ("mesh triangles for same error", "mesh_triangles_for_same_error", "int"), ("spline cheaper", "spline_cheaper", "s"),
-             ("note", "note", "s")], _fmt))
+             ("note", "note", "s")]))
     result["throughput"] = construction_throughput(n=257 if quick else 1025)
-    (out / "throughput.md").write_text("# Construction throughput\n\n" + _md_table(
+    (out / "throughput.md").write_text("# Construction throughput\n\n" + md_table(
         result["throughput"], [("scheme", "scheme", "s"), ("grid", "grid", "s"), ("patches", "patches", "int"),
-                               ("seconds", "seconds", "f2"), ("patches/s", "patches_per_s", "e")], _fmt))
+                               ("seconds", "seconds", "f2"), ("patches/s", "patches_per_s", "e")]))
     result["scaling"] = scaling(sizes=(65, 257) if quick else (65, 1025))
-    (out / "scaling.md").write_text("# Frame time vs grid size (same view)\n\n" + _md_table(
+    (out / "scaling.md").write_text("# Frame time vs grid size (same view)\n\n" + md_table(
         result["scaling"][:-1], [("grid", "grid", "s"), ("patches", "patches", "int"), ("frame min ms", "frame_min_ms", "f1"),
-                                 ("frame median ms", "frame_median_ms", "f1"), ("screen covered", "screen_covered", "f2")], _fmt)
+                                 ("frame median ms", "frame_median_ms", "f1"), ("screen covered", "screen_covered", "f2")])
         + f"\nratio largest / smallest: {result['scaling'][-1]['ratio_largest_to_smallest']:.2f}\n")
     rows, xs, profiles = cliff_overshoot()
     result["cliff"] = rows
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = pyplot().subplots(figsize=(7, 4))
     for s, prof in profiles.items():
         ax.plot(xs, prof, label=s)
     ax.set_xlim(0.3, 0.7)
@@ -437,12 +406,10 @@ def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
     ax.set_title("Step cliff: overshoot of each scheme")
     ax.legend()
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out / "cliff.png", dpi=110)
-    plt.close(fig)
-    (out / "cliff.md").write_text("# Step cliff (0 | 1)\n\n" + _md_table(
-        rows, [("scheme", "scheme", "s"), ("overshoot above 1", "overshoot", "e"), ("undershoot below 0", "undershoot", "e")], _fmt))
-    (out / "terrain.json").write_text(json.dumps(result, indent=2))
+    save_figure(fig, out / "cliff.png", dpi=110)
+    (out / "cliff.md").write_text("# Step cliff (0 | 1)\n\n" + md_table(
+        rows, [("scheme", "scheme", "s"), ("overshoot above 1", "overshoot", "e"), ("undershoot below 0", "undershoot", "e")]))
+    write_json(out / "terrain.json", result)
     return result
 
 

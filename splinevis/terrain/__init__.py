@@ -12,3 +12,4 @@ from .schemes import (
     scheme_stencil as scheme_stencil,
     terrain_coefficients as terrain_coefficients,
 )
+from .prefilter import smooth_heights as smooth_heights

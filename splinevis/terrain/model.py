@@ -1,4 +1,4 @@
-"""TerrainSpline: a quartic spline on the type-1 triangulation of a height grid (paper 000).
+"""TerrainSpline: a quartic spline on the type-1 triangulation of a height grid [Reis2008, sec. IV].
 
 The model is immutable float64 numpy and never imports VTK. Geometry is kept exactly as the data gave
 it: anisotropic spacing and real-world origins (UTM eastings of 5e5, northings of 5e6) are stored in
@@ -83,13 +83,29 @@ class TerrainSpline:
         return cls(coefficients, cell_spacing, origin, z_ref, scheme="custom", source="coefficients")
 
     @classmethod
-    def from_heights(cls, heights, scheme: str = "C1", **read_options) -> "TerrainSpline":
-        """Apply ``scheme`` to height data (anything :func:`splinevis.io.read_heights` reads)."""
+    def from_heights(cls, heights, scheme: str = "C1", *, presmooth: int = 0, **read_options) -> "TerrainSpline":
+        """Apply ``scheme`` to height data (anything :func:`splinevis.io.read_heights` reads).
+
+        ``presmooth`` > 0 first smooths the heights with that many passes of the binomial filter on the GPU
+        (:func:`splinevis.terrain.prefilter.smooth_heights`: for noisy measured data).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> z = np.zeros((9, 9)); z[4, 4] = 1.0
+        >>> t = TerrainSpline.from_heights(z, "C2", presmooth=1)
+        >>> round(float(t.evaluate(4.0, 4.0)) - t.z_ref, 4) < round(float(TerrainSpline.from_heights(z, "C2").evaluate(4.0, 4.0)) - t.z_ref, 4)
+        True
+        """
         from ..io import HeightGrid, read_heights
         from .schemes import SCHEMES, terrain_coefficients
 
         check_choice(scheme, "scheme", set(SCHEMES))
         grid = heights if isinstance(heights, HeightGrid) else read_heights(heights, **read_options)
+        if presmooth:
+            from .prefilter import smooth_heights
+
+            grid = smooth_heights(grid, presmooth)
         z = np.asarray(grid.heights, dtype=np.float64)
         z_ref = float(np.mean(z))
         coef, info = terrain_coefficients(z - z_ref, scheme)

@@ -136,9 +136,9 @@ def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t) 
                                  o_mc, directions, t, coord, proxy_size=float(max(x1 - x0, y1 - y0, np.ptp(terrain.zrange))))
 
 
-def _model_from(heights, scheme: str = "C1", **read_options) -> TerrainSpline:
+def _model_from(heights, scheme: str = "C1", presmooth: int = 0, **read_options) -> TerrainSpline:
     """A TerrainSpline from anything :func:`splinevis.io.read_heights` reads, or a HeightGrid."""
-    return TerrainSpline.from_heights(heights, scheme, **read_options)
+    return TerrainSpline.from_heights(heights, scheme, presmooth=presmooth, **read_options)
 
 
 PROGRAM = SplineProgram(
