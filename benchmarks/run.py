@@ -12,7 +12,7 @@ Cases
   cubic, block / cube proxies, data / coefficient encoding, culling on / off) side by side with a flying-edges
   marching cubes mesh and VTK's GPU isosurface ray caster of the same data.
 * ``terrain``: the terrain ray caster on 65x65 .. 1025x1025 grids in one full-screen view, with the
-  min/max hierarchy on and off (the hierarchical equivalent of the paper's front-to-back occlusion sets).
+  min/max hierarchy on and off (the hierarchical equivalent of the front-to-back occlusion sets of [Reis2008, sec. VII]).
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against

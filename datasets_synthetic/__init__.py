@@ -1,6 +1,6 @@
 """Generators of the synthetic test data (no downloads): analytic functions sampled on grids.
 
-Volumes (issue 4): analytic scalar fields with exact gradients and a file writer, in
+Volumes: analytic scalar fields with exact gradients and a file writer, in
 :mod:`datasets_synthetic.volumes`; the names below are re-exported from there.
 """
 

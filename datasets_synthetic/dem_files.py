@@ -196,9 +196,8 @@ def fractal_terrain(n: int, seed: int = 0, *, hurst: float = 0.8, amplitude: flo
     """(n, n) float64 fractal heights in ``[0, amplitude]`` by spectral synthesis.
 
     White Gaussian noise is shaped in Fourier space by ``|k|**-(hurst + 1)`` (fractional Brownian
-    surface, fractal dimension ``3 - hurst``) and transformed back; the result is periodic. Reference:
-    R. F. Voss, "Random fractal forgeries", in Fundamental Algorithms for Computer Graphics (1985),
-    doi:10.1007/978-3-642-84574-1_34.
+    surface, fractal dimension ``3 - hurst``) and transformed back; the result is periodic
+    [Voss1985].
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
         raise ValueError(f"n must be an integer >= 2, got {n!r}.")

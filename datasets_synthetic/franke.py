@@ -1,5 +1,5 @@
-"""Franke's test function (R. Franke, "Scattered data interpolation: tests of some methods",
-Math. Comp. 38 (1982)), the surface of paper 000's Table I, and its exact gradient."""
+"""Franke's test function [Franke1982], the surface of the accuracy table [Reis2008, Table I], and its
+exact gradient."""
 
 from __future__ import annotations
 

@@ -174,8 +174,7 @@ class AnalyticField:
 # Marschner-Lobb
 # --------------------------------------------------------------------------------------------------
 def marschner_lobb(alpha: float = 0.25, f_m: float = 6.0) -> AnalyticField:
-    """The Marschner-Lobb signal (S. Marschner, R. Lobb, "An evaluation of reconstruction filters for
-    volume rendering", IEEE Visualization 1994) on [-1, 1]^3, level 0.5::
+    """The Marschner-Lobb signal [MarschnerLobb1994] on [-1, 1]^3, level 0.5::
 
         f = (1 - sin(pi z / 2) + alpha (1 + cos(2 pi f_M cos(pi r / 2)))) / (2 (1 + alpha)),  r = sqrt(x^2 + y^2)
 

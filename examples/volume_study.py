@@ -1,5 +1,5 @@
 """Run the volume study: approximation, accuracy vs time against marching cubes and VTK's ray caster,
-memory and preprocessing (paper 003, Table 1 layout), side-by-side figures.
+memory and preprocessing (in the layout of [Kalbe2008, Table 1]), side-by-side figures.
 
     python examples/volume_study.py [out_dir] [--quick]
 """

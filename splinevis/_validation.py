@@ -15,6 +15,14 @@ def as_float64_array(value, name: str, *, ndim: int | tuple | None = None, shape
     """Return ``value`` as a float64 array after checking its dimensions, trailing shape and finiteness.
 
     ``shape_tail`` lists the required sizes of the last axes (None for "any").
+
+    Examples
+    --------
+    >>> as_float64_array([[1, 2, 3]], "points", shape_tail=(3,))
+    array([[1., 2., 3.]])
+    >>> as_float64_array([1, 2], "points", shape_tail=(3,))
+    Traceback (most recent call last):
+    ValueError: points must have shape (..., 3), got (2,).
     """
     try:
         arr = np.asarray(value, dtype=np.float64)
@@ -36,7 +44,14 @@ def as_float64_array(value, name: str, *, ndim: int | tuple | None = None, shape
 
 
 def check_finite(arr: np.ndarray, name: str) -> None:
-    """Raise ValueError naming the first non-finite entry of ``arr``."""
+    """Raise ValueError naming the first non-finite entry of ``arr``.
+
+    Examples
+    --------
+    >>> check_finite(np.array([[0.0, 1.0], [np.inf, np.nan]]), "heights")
+    Traceback (most recent call last):
+    ValueError: heights must have finite values; found 2 non-finite, the first inf at index (1, 0).
+    """
     bad = ~np.isfinite(arr)
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
@@ -47,7 +62,16 @@ def check_finite(arr: np.ndarray, name: str) -> None:
 
 
 def check_degree(degree, name: str = "degree", *, low: int = 0, high: int | None = None) -> int:
-    """Return ``degree`` as an int after checking ``low <= degree <= high``."""
+    """Return ``degree`` as an int after checking ``low <= degree <= high``.
+
+    Examples
+    --------
+    >>> check_degree(np.int64(3), high=4)
+    3
+    >>> check_degree(5, "newton_iterations", low=1, high=4)
+    Traceback (most recent call last):
+    ValueError: newton_iterations must be in 1..4, got 5.
+    """
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
         raise TypeError(f"{name} must be an integer, got {type(degree).__name__} {degree!r}.")
     degree = int(degree)
@@ -58,6 +82,14 @@ def check_degree(degree, name: str = "degree", *, low: int = 0, high: int | None
 
 
 def check_choice(value, name: str, choices) -> None:
-    """Raise ValueError listing the accepted values when ``value`` is not one of ``choices``."""
+    """Raise ValueError listing the accepted values when ``value`` is not one of ``choices``.
+
+    Examples
+    --------
+    >>> check_choice("C1", "scheme", {"C1", "C2"})  # accepted: returns None
+    >>> check_choice("C3", "scheme", {"C1", "C2"})
+    Traceback (most recent call last):
+    ValueError: scheme 'C3' is not known; choose one of: 'C1', 'C2'.
+    """
     if value not in choices:
         raise ValueError(f"{name} {value!r} is not known; choose one of: {', '.join(map(repr, sorted(choices)))}.")

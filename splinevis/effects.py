@@ -186,6 +186,13 @@ class Style:
 
         An output mode (normals, curvature, depth) replaces shading, so lights, colours and overlays
         are not compiled in with it.
+
+        Examples
+        --------
+        >>> sorted(Style(lights=2, opacity=0.5).effect_set())
+        ['lights', 'transparency']
+        >>> Style(lights=2, reflection_lines=12, output="normals").effect_set()
+        frozenset({'normals'})
         """
         if self.output is not None:
             return frozenset({self.output})
@@ -206,7 +213,13 @@ class Style:
         return frozenset(on)
 
     def defines(self) -> dict:
-        """Compile-time flags for the declared effects (``SV_NUM_LIGHTS`` carries the count)."""
+        """Compile-time flags for the declared effects (``SV_NUM_LIGHTS`` carries the count).
+
+        Examples
+        --------
+        >>> sorted(Style(lights=2, specular=True).defines().items())
+        [('SV_NUM_LIGHTS', 2), ('SV_SPECULAR', True)]
+        """
         out = {}
         for name in self.effect_set():
             flag = EFFECTS[name][0]
@@ -214,7 +227,13 @@ class Style:
         return out
 
     def include_files(self) -> list[str]:
-        """The effect files to include, without duplicates, in a stable order."""
+        """The effect files to include, without duplicates, in a stable order.
+
+        Examples
+        --------
+        >>> Style(lights=2, specular=True, reflection_lines=12).include_files()
+        ['lib/effects/lights.glsl', 'lib/effects/reflection_lines.glsl']
+        """
         files = []
         for name in EFFECTS:
             if name in self.effect_set() and EFFECTS[name][1] not in files:
@@ -223,13 +242,26 @@ class Style:
 
     # -- parameters -----------------------------------------------------------------------------------
     def light_directions_camera(self) -> np.ndarray:
-        """(lights, 3) unit directions towards each light in camera coordinates."""
+        """(lights, 3) unit directions towards each light in camera coordinates.
+
+        Examples
+        --------
+        >>> d = Style(lights=2).light_directions_camera()
+        >>> d.shape, np.linalg.norm(d, axis=1).round(12)
+        ((2, 3), array([1., 1.]))
+        """
         d = np.asarray(_DEFAULT_LIGHTS[: self.lights], dtype=np.float64).reshape(-1, 3)
         return d / np.linalg.norm(d, axis=1, keepdims=True)
 
     def uniforms(self) -> dict:
         """Scalar and vector uniforms (name -> float or tuple); set without recompiling (uniforms of
-        effects that are not compiled in are simply not found by the driver and ignored)."""
+        effects that are not compiled in are simply not found by the driver and ignored).
+
+        Examples
+        --------
+        >>> Style(lights=1, color=(1.0, 0.5, 0.0), reflection_lines=8).uniforms()
+        {'sv_color': (1.0, 0.5, 0.0), 'sv_ambient': 0.15, 'sv_diffuse': 0.85, 'sv_stripes': 8.0}
+        """
         u = {"sv_color": self.color, "sv_ambient": float(self.ambient), "sv_diffuse": float(self.diffuse)}
         if self.specular:
             u["sv_specular_power"] = float(self.specular_power)
@@ -246,7 +278,14 @@ class Style:
         return u
 
     def replace(self, **changes) -> "Style":
-        """A copy with some fields changed (styles are immutable)."""
+        """A copy with some fields changed (styles are immutable).
+
+        Examples
+        --------
+        >>> s = Style(lights=2)
+        >>> s.replace(lights=3, specular=True).lights, s.lights
+        (3, 2)
+        """
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         unknown = set(changes) - set(values)
         if unknown:

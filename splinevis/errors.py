@@ -17,15 +17,40 @@ __all__ = [
 
 
 class SplinevisError(Exception):
-    """Base class of all splinevis errors."""
+    """Base class of all splinevis errors.
+
+    Examples
+    --------
+    >>> issubclass(ShaderCompileError, SplinevisError), issubclass(ShaderCompileError, RuntimeError)
+    (True, True)
+    """
 
 
 class OpenGLUnavailableError(SplinevisError, RuntimeError):
-    """No OpenGL context could be made (VTK would otherwise render blank images silently)."""
+    """No OpenGL context could be made (VTK would otherwise render blank images silently).
+
+    Examples
+    --------
+    >>> try:
+    ...     raise OpenGLUnavailableError("no EGL display")
+    ... except RuntimeError as exc:  # caught as a RuntimeError too
+    ...     print(type(exc).__name__, exc)
+    OpenGLUnavailableError no EGL display
+    """
 
 
 class ShaderIncludeError(SplinevisError, FileNotFoundError):
-    """A ``#include`` in a GLSL file names a file that does not exist, or includes form a cycle."""
+    """A ``#include`` in a GLSL file names a file that does not exist, or includes form a cycle.
+
+    Examples
+    --------
+    >>> from splinevis.gl.assembler import assemble
+    >>> assemble('#include "lib/no_such_file.glsl"\\nvoid main() {}')
+    Traceback (most recent call last):
+    splinevis.errors.ShaderIncludeError: ...no_such_file.glsl...
+    >>> issubclass(ShaderIncludeError, FileNotFoundError)
+    True
+    """
 
 
 # Mesa/llvmpipe logs look like "0:12(5): error: ..." ; NVIDIA like "0(12) : error C0000: ...";
@@ -67,6 +92,14 @@ class ShaderCompileError(SplinevisError, RuntimeError):
     locations : list of (int, str, str | None)
         For each log line that names a source line: the line number, the message and, when the
         source came from :func:`splinevis.gl.assembler.assemble`, ``"file:line"`` in ``glsl/``.
+
+    Examples
+    --------
+    >>> err = ShaderCompileError("0:2(5): error: `x' undeclared", "void main() {\\n  x = 1;\\n}", "fragment")
+    >>> err.locations
+    [(2, "error: `x' undeclared", None)]
+    >>> print(str(err).splitlines()[-2:])
+    ["line 2: error: `x' undeclared", '    x = 1;']
     """
 
     def __init__(self, log: str, source: str, stage: str = "unknown", origin=None):

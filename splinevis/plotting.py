@@ -96,6 +96,19 @@ class Plotter(pv.Plotter):
         SplineActor
             Holds the VTK actor (``.actor``), the assembled GLSL (``.assembled``) and, after the first
             render, the compiled sources (``.program_sources``).
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> actor = pl.add_spline(QuarticTrianglePatch.demo(), lights=2, reflection_lines=8,
+        ...                       program_options={"roots": "paper"})
+        >>> actor.program.name, sorted(actor.style.effect_set()), actor.spec.defines["SV_ROOTS_PAPER"]
+        ('analytic_patch', ['lights', 'reflection_lines'], True)
+        >>> pl.add_spline(QuarticTrianglePatch.demo(), reflection_line=8)
+        Traceback (most recent call last):
+        TypeError: unknown effect or style option 'reflection_line' (did you mean 'reflection_lines'?); known: ...
+        >>> pl.close()
         """
         from .programs import program_for
 
@@ -174,13 +187,38 @@ class Plotter(pv.Plotter):
         return actor
 
     def render(self) -> None:
-        """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`."""
+        """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`.
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> actor = pl.add_spline(QuarticTrianglePatch.demo())
+        >>> actor.program_sources
+        {}
+        >>> pl.show(auto_close=False)  # the first frame; later ones: pl.render()
+        >>> pl.render()
+        >>> sorted(actor.program_sources), len(actor.program_ids)  # compiled once
+        (['fragment', 'vertex'], 1)
+        >>> pl.close()
+        """
         with capture_vtk_errors() as cap:
             super().render()
         self._after_render(cap.text)
 
     def render_now(self) -> None:
-        """Render the window immediately and wait for the GL pipeline (what benchmarks time)."""
+        """Render the window immediately and wait for the GL pipeline (what benchmarks time).
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> actor = pl.add_spline(QuarticTrianglePatch.demo())
+        >>> pl.render_now()
+        >>> "sv_surface_hit" in actor.program_sources["fragment"]
+        True
+        >>> pl.close()
+        """
         if self._first_time:
             self.show(auto_close=False)
         with capture_vtk_errors() as cap:
@@ -201,6 +239,17 @@ class Plotter(pv.Plotter):
         """Window depth in [0, 1] per pixel, (H, W), row 0 at the top like :meth:`screenshot`.
 
         Read straight from the framebuffer (pyvista's ``get_image_depth`` would reset the clipping range).
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> _ = pl.add_spline(QuarticTrianglePatch.demo())
+        >>> _ = pl.screenshot()
+        >>> depth = pl.depth_buffer()
+        >>> depth.shape, float(depth[0, 0]), bool(depth.min() < 1.0)  # background 1, the patch nearer
+        ((48, 64), 1.0, True)
+        >>> pl.close()
         """
         w, h = self.window_size
         from vtkmodules.vtkCommonCore import vtkFloatArray
@@ -213,7 +262,18 @@ class Plotter(pv.Plotter):
 
     def camera_matrix(self) -> np.ndarray:
         """(4, 4) float64 world -> normalized device coordinates of the active camera at this window's
-        aspect ratio (the matrix VTK's shaders use, in double precision)."""
+        aspect ratio (the matrix VTK's shaders use, in double precision).
+
+        Examples
+        --------
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> pl.camera_position = [(0.0, 0.0, 5.0), (1.0, 2.0, 0.0), (0.0, 1.0, 0.0)]
+        >>> m = pl.camera_matrix()
+        >>> clip = m @ [1.0, 2.0, 0.0, 1.0]  # the focal point projects to the centre of the window
+        >>> m.shape, (clip[:2] / clip[3]).round(12) + 0.0
+        ((4, 4), array([0., 0.]))
+        >>> pl.close()
+        """
         w, h = self.window_size
         cam = self.renderer.GetActiveCamera()
         m = cam.GetCompositeProjectionTransformMatrix(w / h, -1, 1)

@@ -47,6 +47,18 @@ def register(program: SplineProgram, *, replace: bool = False) -> SplineProgram:
         ``program`` is not a SplineProgram, or a callable has the wrong calling convention.
     ValueError
         A program of that name is registered already (pass ``replace=True`` to replace it).
+
+    Examples
+    --------
+    >>> class Dots:
+    ...     pass
+    >>> dots = register(SplineProgram("dots", "mesh", Dots, build=lambda model, style, *, newton_iterations: None))
+    >>> program_for(Dots()) is dots
+    True
+    >>> register(dots)
+    Traceback (most recent call last):
+    ValueError: a program named 'dots' is registered already; pass replace=True to replace it.
+    >>> unregister("dots")
     """
     if not isinstance(program, SplineProgram):
         raise TypeError(f"register takes a splinevis.gl.contract.SplineProgram, got {type(program).__name__}.")
@@ -61,7 +73,20 @@ def register(program: SplineProgram, *, replace: bool = False) -> SplineProgram:
 
 
 def unregister(name: str) -> None:
-    """Remove the family ``name`` (built-in families come back only in a new process)."""
+    """Remove the family ``name`` (built-in families come back only in a new process).
+
+    Examples
+    --------
+    >>> class Dots:
+    ...     pass
+    >>> _ = register(SplineProgram("dots", "mesh", Dots, build=lambda model, style, *, newton_iterations: None))
+    >>> unregister("dots")
+    >>> "dots" in [p.name for p in all_programs()]
+    False
+    >>> unregister("dots")
+    Traceback (most recent call last):
+    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface."
+    """
     _load_builtin()
     if name not in _programs:
         raise KeyError(f"no program named {name!r}; registered: {', '.join(_programs)}.")
@@ -69,13 +94,25 @@ def unregister(name: str) -> None:
 
 
 def all_programs() -> list[SplineProgram]:
-    """Every registered program, built-in ones first."""
+    """Every registered program, built-in ones first.
+
+    Examples
+    --------
+    >>> [(p.name, p.kind) for p in all_programs()]
+    [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast')]
+    """
     _load_builtin()
     return list(_programs.values())
 
 
 def get(name: str) -> SplineProgram:
-    """The program registered as ``name``."""
+    """The program registered as ``name``.
+
+    Examples
+    --------
+    >>> get("isosurface").root_methods, get("isosurface").newton_iterations
+    (('analytic', 'bracketed', 'paper'), 6)
+    """
     _load_builtin()
     try:
         return _programs[name]
@@ -90,6 +127,15 @@ def program_for(model) -> SplineProgram:
     ------
     TypeError
         No registered program draws this type; the message lists what can be drawn.
+
+    Examples
+    --------
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> program_for(QuarticTrianglePatch.demo()).name
+    'analytic_patch'
+    >>> program_for(1.5)
+    Traceback (most recent call last):
+    TypeError: no spline program draws a float; registered programs draw: QuarticTrianglePatch (analytic_patch), ...
     """
     _load_builtin()
     for cls in type(model).__mro__:

@@ -30,30 +30,45 @@ EPS32 = 2.0**-23
 
 
 def gamma_eps(m: int) -> float:
-    """``gamma_m = m u / (1 - m u)`` (Higham, *Accuracy and Stability of Numerical Algorithms*, 3.4) in
-    units of eps32 = 2u."""
+    """``gamma_m = m u / (1 - m u)`` [Higham2002, sec. 3.4] in units of eps32 = 2u.
+
+    >>> gamma_eps(12)  # m u / eps32 = m / 2, enlarged by 1 / (1 - m u)
+    6.000004291537493
+    """
     return m * U32 / (1.0 - m * U32) / EPS32
 
 
 def EVAL_BOUND(n: int) -> float:
     """de Casteljau of degree n: each of the n levels computes s*a + t*b with s = fl(1 - t): at most 3
     roundings per term per level (1 - t, the product, the sum), so
-    ``|fl(f) - f| <= gamma_{3n} sum_k |c_k| B_k(t)`` (Farin, ch. 3; Mainar & Pena 1999). An FMA only
-    removes roundings. Error unit: eps32 * sum_k |c_k| B_k(t)."""
+    ``|fl(f) - f| <= gamma_{3n} sum_k |c_k| B_k(t)`` [Farin2002, ch. 3; MainarPena1999]. An FMA only
+    removes roundings. Error unit: eps32 * sum_k |c_k| B_k(t).
+
+    >>> EVAL_BOUND(4) == gamma_eps(12)
+    True
+    """
     return gamma_eps(3 * n)
 
 
 def DERIV_BOUND(n: int) -> float:
     """f' = n (b1 - b0) after n - 1 levels: b0, b1 carry gamma_{3(n-1)}, the difference and the product
     by n one rounding each, so ``|err| <= gamma_{3n-1} n sum_k (|c_k| + |c_{k+1}|) B^{n-1}_k(t)``. Error
-    unit: eps32 * n sum_k (|c_k| + |c_{k+1}|) B^{n-1}_k(t)."""
+    unit: eps32 * n sum_k (|c_k| + |c_{k+1}|) B^{n-1}_k(t).
+
+    >>> DERIV_BOUND(4)  # gamma_11
+    5.500003606083373
+    """
     return gamma_eps(3 * n - 1)
 
 
 def RESTRICT_BOUND() -> float:
     """Quartic triangle blossom: 4 levels of l.x*a + l.y*b + l.z*c (a product and at most two sums per
     term: 3 roundings per level), so ``|err_k| <= gamma_{12} blossom(|b|; |l0|^{4-k}, |l1|^k)``. Error
-    unit: eps32 * that blossom."""
+    unit: eps32 * that blossom.
+
+    >>> RESTRICT_BOUND() == gamma_eps(12)
+    True
+    """
     return gamma_eps(12)
 
 
@@ -62,7 +77,11 @@ def ROOT_BOUND(n: int) -> float:
     ``|fl32 f(x)| <= K_n eps32 S`` so the exact ``|f(x)| <= (K_n + EVAL_BOUND(n)) eps32 S``; the twin's x
     passes ``|f(x)| <= K_n eps32 S`` in float64. To first order ``|x - x*| <= |f(x)| / |f'(x*)|``, so
     ``|x_glsl - x_twin| <= (2 K_n + EVAL_BOUND(n)) eps32 S / |f'|``. Error unit: eps32 S(x*) / |f'(x*)|.
-    Valid while f' changes by less than half over that interval (else the case is ill-conditioned)."""
+    Valid while f' changes by less than half over that interval (else the case is ill-conditioned).
+
+    >>> ROOT_BOUND(4)  # 2 K_4 + gamma_12
+    30.000370502474993
+    """
     return 2.0 * _roots.root_tolerance_k(n) + EVAL_BOUND(n)
 
 
@@ -237,6 +256,11 @@ def classify_first_roots(c, x, n: int, absolute_bound: float = 0.0, ref=None) ->
     ``|f(x)| <= (K_n + EVAL_BOUND(n)) eps32 S(x)`` (a complex pair near the real axis: indistinguishable
     from a double root in float32), an ``earlier_root_missed_by_reference`` if ``f`` changes sign (in
     float64) within ``absolute_bound`` of ``x``, and ``earlier_wrong`` otherwise. Returns boolean masks.
+
+    >>> c = np.array([[3 / 16, -1 / 16, -7 / 48, -1 / 16, 3 / 16]] * 3)  # (t - 1/4)(t - 3/4)
+    >>> cl = classify_first_roots(c, np.array([0.25, 0.75, np.nan]), 4)
+    >>> cl["match"].tolist(), cl["later"].tolist(), cl["missed"].tolist()
+    ([True, False, False], [False, True, False], [False, False, True])
     """
     c = np.asarray(c, dtype=np.float64)
     x = np.asarray(x, dtype=np.float64)
@@ -335,7 +359,7 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
     from .gl.harness import run_glsl
 
     c32, kind = _root_inputs(rng, m, n)
-    if method == "newton4":      # paper 000's method
+    if method == "newton4":      # the 4-start Newton of [Reis2008, sec. V]
         glsl_name, twin, absolute_bound = "sv_first_root_newton4", _roots.newton_secure, 0.0
     else:                        # bracketed Newton on convex pieces: the bracket is <= 4^-N wide
         glsl_name, twin, absolute_bound = "sv_first_root_bracketed", _roots.first_root_bracketed, 4.0**-iterations
@@ -464,11 +488,16 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
     results[f"first_root_n{n}" if method == "newton4" else f"first_root_bracketed_n{n}"] = res
 
 
-def program_hard_cases(progress: bool = True) -> dict:
+def program_hard_cases(progress: bool = True, *, only=None) -> dict:
     """Every registered ray-cast program (:mod:`splinevis.programs`) on the hard cases it declares, GPU against
-    its float64 twin per pixel (:func:`splinevis.analysis.agreement.hard_case_agreement`).
+    its float64 twin per pixel (:func:`splinevis.analysis.agreement.hard_case_agreement`); ``only``: the
+    ``"program/case"`` names to run (default all).
 
     Returns ``{program: {case: {pixels, both, leaks, hit_disagree, within_bound, failures, pass}}}``.
+
+    >>> r = program_hard_cases(False, only=["analytic_patch/camera-inside-prism"])
+    >>> r["analytic_patch"]["camera-inside-prism"]["failures"], r["analytic_patch"]["camera-inside-prism"]["pass"]
+    ([], True)
     """
     from tqdm.auto import tqdm
 
@@ -476,7 +505,7 @@ def program_hard_cases(progress: bool = True) -> dict:
     from .programs import all_programs
 
     cases = [(p.name, c) for p in all_programs() if p.kind == "raycast" and p.hard_cases is not None
-             for c in p.hard_cases()]
+             for c in p.hard_cases() if only is None or f"{p.name}/{c.name}" in only]
     out: dict = {}
     for name, case in tqdm(cases, disable=not progress, desc="hard cases", unit="case"):
         r = hard_case_agreement(case)
@@ -505,7 +534,7 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
         Show a tqdm progress bar.
     iterations : int
         Steps of both root finders (the paper's 6; the ray caster's default ``newton_iterations``):
-        ``first_root_n*`` rows test paper 000's ``sv_first_root_newton4`` against
+        ``first_root_n*`` rows test ``sv_first_root_newton4`` ([Reis2008, sec. V]) against
         :func:`~splinevis.bb.roots.newton_secure`, ``first_root_bracketed_n*`` rows the default
         ``sv_first_root_bracketed`` against :func:`~splinevis.bb.roots.first_root_bracketed`. Both rows
         carry ``vs_reference``: miss / wrong-root counts on well-conditioned first roots.
@@ -517,6 +546,15 @@ def run_selftest(out_dir, *, cases: int = 100_000, seed: int = 0, progress: bool
     dict
         ``{"functions": {name: {cases, max_err_eps, median_err_eps, bound_eps, pass, ...}}, "pass": bool,
         "seconds": float, ...}``; the same is written to ``out_dir/selftest.json``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as out:
+    ...     report = run_selftest(out, cases=1000, progress=False, programs=False)
+    ...     written = json.loads((Path(out) / "selftest.json").read_text())
+    >>> report["pass"], len(report["functions"]), written["functions"].keys() == report["functions"].keys()
+    (True, 15, True)
     """
     from tqdm.auto import tqdm
 

@@ -245,7 +245,7 @@ def test_bracketed_never_misses_well_conditioned_first_roots_1e5_quartics():
         # the rest match within the derived bound, or are earlier near-roots passing the residual test
         # (complex pairs within float32 rounding of the real axis) or earlier roots the reference missed
         assert (cl["match"] | cl["earlier_near_root"] | cl["earlier_root_missed_by_reference"]).sum() == well
-    # documented, not hidden: paper 000's method misses or returns a later root in a sizeable fraction
+    # documented, not hidden: the 4-start Newton of [Reis2008, sec. V] misses or returns a later root in a sizeable fraction
     paper_bad = paper["missed"].sum() + paper["later"].sum()
     print(f"well-conditioned first roots: {well}; paper method missed {paper['missed'].sum()}, "
           f"later root {paper['later'].sum()}; bracketed missed 0, wrong 0")

@@ -1,4 +1,4 @@
-"""Cubic first roots (issue 4): the stable closed form and paper 003's Newton from three starts.
+"""Cubic first roots: the stable closed form and the Newton iteration of [Kalbe2008, sec. 5.3] from three starts.
 
 GLSL (``sv_first_root_cubic``, ``sv_first_root_newton3``) against the float32 twins on the GPU, the float64
 twins against the robust reference, hard cases, and the comparison on ray-restricted spline cubics.
@@ -191,7 +191,7 @@ def test_compare_root_methods_table(ray_cubics):
     assert a["missed"] == 0 and a["later"] == 0 and a["spurious"] == a["spurious_near_root"]
     assert a["correct"] >= table["_with_root"] - 2
     assert table["bracketed I=5"]["missed"] == 0
-    # measured, not assumed: paper 003's Newton with I = 5 misses some first roots on these inputs
+    # measured, not assumed: the 3-start Newton of [Kalbe2008, sec. 5.3] with I = 5 misses some first roots on these inputs
     assert table["newton3 paper I=5"]["correct"] <= a["correct"]
     masks = compare_root_methods(c[:100], iterations=(5,), masks=True)
     assert masks["analytic cubic"]["correct"].dtype == bool

@@ -10,7 +10,7 @@ Error bounds are derived from float64 rounding (unit roundoff u = 2^-53, gamma_m
   S_union <= 2 S offsets involved.
 * A k-th derivative along x or y of a quartic is a combination of coefficients with absolute weight sum
   at most D_k = 4!/(4-k)! * 2^k (each step: n times differences with barycentric direction weights summing
-  to 2 in absolute value), and de Casteljau adds at most gamma_(3n+2k) D_k * max|c| (Farin; Higham).
+  to 2 in absolute value), and de Casteljau adds at most gamma_(3n+2k) D_k * max|c| [Farin2002, ch. 17.3; Higham2002, sec. 3.4].
 * A jump is a difference of two evaluations: twice the one-sided bound.
 """
 

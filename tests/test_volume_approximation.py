@@ -1,6 +1,6 @@
 """Trilinear baseline and the approximation study (splinevis.volume.trilinear, .approximation).
 
-Expected orders (paper 003, Sect. 4 and 6; docs/volume-schemes.md): both splines reproduce the gradients
+Expected orders ([Kalbe2008, sec. 4 and 6]; docs/volume-schemes.md): both splines reproduce the gradients
 of all quadratics (values up to a constant h^2 (a_xx + a_yy + a_zz) / 4), so their value and gradient
 errors are C h^2 + O(h^3); trilinear interpolation reproduces trilinear polynomials only: values O(h^2),
 gradients O(h). For e(h) = C h^2 (1 + D h) the observed order between h and h/2 is
@@ -110,7 +110,7 @@ def test_smooth_field_orders(smooth_table):
 
 
 def test_cubic_constants_slightly_better_for_gradients(smooth_table, ml_table):
-    """Paper 003, Sect. 6: "the constants are slightly better for cubics". Measured: gradient errors of the
+    """[Kalbe2008, sec. 6]: "the constants are slightly better for cubics". Measured: gradient errors of the
     cubic are smaller at every size on both fields (by 0.3 to 7 %); value errors agree to < 1 % (the
     leading error term h^2 Laplacian(f) / 4 is the same for both schemes), so only gradients are asserted."""
     for table in (smooth_table, ml_table):

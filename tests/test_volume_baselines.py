@@ -1,4 +1,4 @@
-"""Baselines of issue 4 (splinevis.volume.baselines): marching cubes meshes and VTK's GPU isosurface ray caster.
+"""Baselines of the volume isosurfaces (splinevis.volume.baselines): marching cubes meshes and VTK's GPU isosurface ray caster.
 
 Error bounds used below, for the signed distance field f(p) = |p - c| - R of a sphere sampled on spacing h:
 

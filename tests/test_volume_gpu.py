@@ -36,7 +36,7 @@ def test_generated_glsl_is_current():
 
 
 def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
-    # Paper 003's fixed-iteration Newton from three starts (0, the inflection point or 1/2, 1) has no
+    # The fixed-iteration Newton of [Kalbe2008, sec. 5.3] from three starts (0, the inflection point or 1/2, 1) has no
     # bracket: a start that has not converged fails the residual test, and the smallest ACCEPTED iterate can
     # be a later root or none (roots near s = 1 are overshot: splinevis.volume.root_methods measures it).
     # It stays selectable so the study can measure it. What must hold: it never reports a hit in front of

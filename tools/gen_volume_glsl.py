@@ -6,10 +6,10 @@ Writes, under glsl/lib/:
   constant table: ``lam_i = dot(SV_TET_BARY[4 t + i], vec4(local, 1))``;
 * ``simplex/tet_steps.glsl`` -- de Casteljau steps of tetrahedral BB polynomials of degree 3 -> 2 -> 1 -> 0 with
   constant indices (no dynamic indexing of local arrays: that spills to memory on llvmpipe), and the
-  restriction of a quadratic or cubic to a segment by blossoming (paper 003, sec. 5.3, Fig. 10);
+  restriction of a quadratic or cubic to a segment by blossoming ([Kalbe2008, sec. 5.3, Fig. 10]);
 * ``type6/stencil_<scheme>.glsl`` and ``type6/determining_cubic.glsl`` -- ``sv_tet_coefficients(t, f, b)``: the BB coefficients of
-  tetrahedron t of a cube from the cube's 27 data values (the scheme's averaging rules, paper 003 sec. 4
-  eq. (3) and Fig. 7, as the fixed weights of splinevis.volume.schemes.tet_weights): tetrahedron 0's rules,
+  tetrahedron t of a cube from the cube's 27 data values (the scheme's averaging rules, [Kalbe2008, sec. 4,
+  eq. (3) and Fig. 7], as the fixed weights of splinevis.volume.schemes.tet_weights): tetrahedron 0's rules,
   weights grouped by value, applied to the data permuted by the cube symmetry taking tetrahedron 0 to t.
 
 Run ``python tools/gen_volume_glsl.py`` after changing a scheme; tests/test_volume_gpu.py checks the files
@@ -79,11 +79,11 @@ def _step(m):
 def tet_steps() -> str:
     doc = ("// One de Casteljau step of a tetrahedral BB polynomial, degree m -> m - 1, at barycentric point l;\n"
            "// coefficients in splinevis.bb.simplex.multi_indices(m, 3) order:\n"
-           "// d[a] = sum_j l[j] s[a + e_j] (Farin, ch. 17; paper 003, eq. (2)).\n\n")
+           "// d[a] = sum_j l[j] s[a + e_j] [Farin2002, ch. 17.3; Kalbe2008, sec. 3].\n\n")
     body = "\n".join(_step(m) for m in (3, 2, 1))
     restrict = """
 // Univariate BB coefficients c[k] = blossom(l0^{n-k}, l1^k), k = 0..n, of the restriction of a quadratic
-// (n = 2) or cubic (n = 3) to the segment from barycentric point l0 to l1 (paper 003, sec. 5.3, Fig. 10;
+// (n = 2) or cubic (n = 3) to the segment from barycentric point l0 to l1 ([Kalbe2008, sec. 5.3, Fig. 10];
 // float64 twin: splinevis.bb.simplex.restrict_to_segment with the same step order).
 void sv_restrict_tet2(float b[10], vec4 l0, vec4 l1, out float c[5]) {
     float a[4];
@@ -149,7 +149,7 @@ def _sigmas():
 
 def determining(scheme: str = "cubic") -> str:
     """``sv_tet_coefficients_det(t, d, b)``: tetrahedron t's coefficients from the cube's 56 determining
-    coefficients d (paper 003 sec. 5.1 encoding), by tetrahedron 0's map applied to the determining points
+    coefficients d (the encoding of [Kalbe2008, sec. 5.1]), by tetrahedron 0's map applied to the determining points
     permuted by the symmetry sigma_t (verified)."""
     from splinevis.volume.cubic import determining_map, determining_set, domain_points
 
@@ -163,8 +163,8 @@ def determining(scheme: str = "cubic") -> str:
             raise ValueError(f"the determining map of tetrahedron {t} is not the symmetric image of tetrahedron 0's.")
     nd = len(pts)
     table = ", ".join(str(int(v)) for v in perms.ravel())
-    out = [HEAD, f"// {scheme}: BB coefficients of tetrahedron t from the cube's {nd} determining coefficients d (paper 003\n"
-           "// sec. 5.1: only the determining set is stored; the other coefficients follow by the smoothness\n"
+    out = [HEAD, f"// {scheme}: BB coefficients of tetrahedron t from the cube's {nd} determining coefficients d\n"
+           "// ([Kalbe2008, sec. 5.1]: only the determining set is stored; the other coefficients follow by the smoothness\n"
            "// conditions, here tetrahedron 0's linear map on the determining points permuted by sigma_t).\n",
            f"const int SV_DET_COUNT = {nd};\nconst int SV_DET_PERM[{24 * nd}] = int[{24 * nd}]({table});\n\n",
            f"void sv_tet_coefficients_det(int t, float d[{nd}], out float b[{M.shape[1]}]) {{\n    float g[{nd}];\n"
@@ -179,7 +179,7 @@ def stencil_permutations(W: np.ndarray) -> np.ndarray:
     """(24, 27) int: for tetrahedron t, the symmetry sigma_t of the cube mapping tetrahedron 0's vertices
     [vQ, wF, u, u'] in order onto tetrahedron t's, as a permutation of the 27 stencil offsets, such that
     ``W[t, q, perm[t, s]] == W[0, q, s]``: the scheme is symmetric, so tetrahedron t's coefficients are
-    tetrahedron 0's rules applied to the permuted data (paper 003 sec. 5.2: "by symmetry of D_q, we do not
+    tetrahedron 0's rules applied to the permuted data ([Kalbe2008, sec. 5.2]: "by symmetry of D_q, we do not
     have different cases for differing tetrahedra"). Raises if the weights are not symmetric."""
     from splinevis.volume.partition import type6_tetrahedra
     from splinevis.volume.schemes import STENCIL
@@ -207,7 +207,7 @@ def stencil(scheme: str) -> str:
     perms = stencil_permutations(W)
     table = ", ".join(str(int(v)) for v in perms.ravel())
     out = [HEAD, f"// BB coefficients of the {scheme} scheme on tetrahedron t of a cube from the cube's 27 data values\n"
-           "// f[s] at offsets splinevis.volume.schemes.STENCIL[s] (x fastest); paper 003 sec. 4, eq. (3), Fig. 7.\n"
+           "// f[s] at offsets splinevis.volume.schemes.STENCIL[s] (x fastest); [Kalbe2008, sec. 4, eq. (3), Fig. 7].\n"
            "// The scheme is symmetric: tetrahedron t applies tetrahedron 0's rules to the data permuted by the cube\n"
            "// symmetry sigma_t mapping tetrahedron 0 onto t (one code path for all 24; a switch over 24 cases cost\n"
            "// three times the frame time of the cubic on llvmpipe).\n"

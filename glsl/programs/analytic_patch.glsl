@@ -1,13 +1,13 @@
 // Ray casting one quartic BB triangle patch z = f(x, y) (the foundation's analytic test surface and the
-// per-patch core of the terrain program; paper 000, sec. V-VI).
+// per-patch core of the terrain program; [Reis2008, sec. V-VI]).
 //
 // Steps 1-3 are lib/simplex/graph_patch.glsl (shared with every terrain triangle):
 // 1. Clip the ray against the prism over the triangle between the smallest and largest coefficient
 //    (the convex-hull property bounds f there).
-// 2. Restrict f to the projected segment by blossoming (paper 000, eq. (6)-(7)): five univariate BB
+// 2. Restrict f to the projected segment by blossoming ([Reis2008, eqs. (6)-(7)]): five univariate BB
 //    coefficients; subtract the ray's height, itself degree-elevated to a quartic.
-// 3. First root in [0,1] (lib/core/roots.glsl sv_first_root): bracketed Newton on convex pieces, or paper
-//    000's Newton from secure starting points when SV_ROOTS_PAPER is defined.
+// 3. First root in [0,1] (lib/core/roots.glsl sv_first_root): bracketed Newton on convex pieces, or the
+//    Newton iteration from secure starting points of [Reis2008, sec. V] when SV_ROOTS_PAPER is defined.
 // 4. Value, gradient (and Hessian for curvature) by de Casteljau at the hit (lib/simplex/bb_triangle.glsl).
 #include "lib/core/raycast.glsl"
 #include "lib/core/table.glsl"

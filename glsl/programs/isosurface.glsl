@@ -1,20 +1,22 @@
 // Ray casting the isosurface s = isovalue of a quadratic or cubic spline on the type-6 partition, per
-// fragment (paper 003, sec. 5).
+// fragment ([Kalbe2008, sec. 5]).
 //
 // Proxy: one box per relevant cube (splinevis.volume.program), rasterized with front faces culled, so
 // each fragment lies on the cube's far side and the camera may be inside the volume. The fragment tests
 // the relevant tetrahedra of its own cube (bit mask, a flat vertex attribute):
-// 1. clip the ray by the tetrahedron's barycentric coordinates (paper 003, sec. 5.3: lam_i >= 0), with
+// 1. clip the ray by the tetrahedron's barycentric coordinates ([Kalbe2008, sec. 5.3]: lam_i >= 0), with
 //    margins against cracks between neighbours (a wide one across the cube's faces, where neighbouring
 //    fragments round the ray independently and the splines are C1, and a narrow one inside the cube);
 // 2. BB coefficients of s on the tetrahedron: recomputed from the cube's 27 data values with the scheme's
-//    averaging rules (encoding "data", the determining data of paper 003 sec. 5.1 taken to the limit: one
-//    value per cube) or read from a table (encoding "coefficients": every coefficient stored);
-// 3. restriction to the segment by blossoming (Fig. 10), isovalue subtracted, first root in [0, 1]:
-//    by the stable closed form of the degree (default), bracketed Newton, or paper 003's Newton from three
-//    starts (selectable; splinevis.volume.root_methods measures them against the robust reference);
+//    averaging rules (encoding "data", the determining data of [Kalbe2008, sec. 5.1] taken to the limit:
+//    one value per cube) or read from a table (encoding "coefficients": every coefficient stored);
+// 3. restriction to the segment by blossoming ([Kalbe2008, Fig. 10]), isovalue subtracted, first root in
+//    [0, 1]: by the stable closed form of the degree (default), bracketed Newton, or the Newton iteration
+//    of [Kalbe2008, sec. 5.3] from three starts (selectable; splinevis.volume.root_methods measures them
+//    against the robust reference);
 // 4. the smallest t over the tetrahedra wins in the cube; across cubes the depth test picks the first.
-// Normal: gradient of s from the degree n - 1 coefficients at the hit (paper 003, sec. 5.3, last para).
+// Normal: gradient of s from the degree n - 1 coefficients at the hit ([Kalbe2008, sec. 5.3], last
+// paragraph).
 // The float64 twin is splinevis.volume.raycast.
 #include "lib/core/raycast.glsl"
 #include "lib/core/table.glsl"
@@ -27,8 +29,8 @@
 #include "lib/type6/stencil_quadratic.glsl"
 #endif
 #ifdef SV_VOLUME_DETERMINING
-// Paper 003's encoding: per relevant cube only its 56 determining coefficients (sampler sv_volume_det, one
-// row of 56 floats per cube); the rest follow from them in the shader.
+// The encoding of [Kalbe2008, sec. 5.1]: per relevant cube only its 56 determining coefficients (sampler
+// sv_volume_det, one row of 56 floats per cube); the rest follow from them in the shader.
 #include "lib/type6/determining_cubic.glsl"
 const int SV_CUBE_VALUES = 56;
 #else
@@ -115,8 +117,9 @@ void sv_load_cube(ivec3 c, int row, out float f[SV_CUBE_VALUES]) {
 }
 
 // First root in [0, 1] of the restricted polynomial minus the isovalue: the stable closed form of the
-// degree (default), paper 003's Newton from three starts (SV_ROOTS_PAPER), or bracketed Newton on
-// convex pieces (SV_ROOTS_BRACKETED); the float64/float32 twins are in splinevis.bb.roots.
+// degree (default), the Newton iteration of [Kalbe2008, sec. 5.3] from three starts (SV_ROOTS_PAPER), or
+// bracketed Newton on convex pieces (SV_ROOTS_BRACKETED); the float64/float32 twins are in
+// splinevis.bb.roots.
 float sv_first_root_deg(float c[5]) {
 #if defined(SV_ROOTS_PAPER)
     return sv_first_root_newton3(c, sv_newton_iterations);
@@ -157,7 +160,7 @@ vec3 sv_tet_gradient(float b[SV_VOL_NCOEF], int t, vec4 l, out float value) {
 // Mean and Gaussian curvature of the level set at barycentric point l of tetrahedron t, from the gradient g
 // and Hessian H (model coordinates): H from the degree-2 blossom a2 of the polynomial at l,
 // H = n (n - 1) G^T A G with A_ij = a2[e_i + e_j] and G_i = grad lam_i, scaled by 1 / spacing per axis.
-// mean = (|g|^2 tr H - g^T H g) / (2 |g|^3), gauss = g^T adj(H) g / |g|^4 (Goldman, CAGD 22 (2005)):
+// mean = (|g|^2 tr H - g^T H g) / (2 |g|^3), gauss = g^T adj(H) g / |g|^4 ([Goldman2005]):
 // 1/r and 1/r^2 for a sphere of radius r of a field increasing outwards. Twin: VolumeSpline.curvature.
 vec2 sv_tet_curvature(float b[SV_VOL_NCOEF], int t, vec4 l, vec3 g) {
     float a2[10];

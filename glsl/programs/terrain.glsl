@@ -2,12 +2,12 @@
 //
 // Proxy: one box around the whole terrain, rasterized with front faces culled. Each fragment's ray is
 // taken to index space (u, v in spline cells, z = height relative to the reference height) and walks a
-// quadtree of (min, max) coefficient bounds, front to back (the hierarchical equivalent of the paper's
-// occlusion sets): a block whose bounds the ray's height range over the block misses is skipped whole;
-// otherwise the walk descends; a cell (level 0) is tested triangle by triangle exactly as one patch of
-// programs/analytic_patch.glsl (clip, restrict by blossoming, first root, paper 000 sec. VI). The frame
-// cost grows with the number of blocks a ray visits (~ log of the grid size for most rays), not with
-// the patch count. The float64 reference is splinevis.terrain.raycast (a plain cell-by-cell DDA).
+// quadtree of (min, max) coefficient bounds, front to back (the hierarchical equivalent of the occlusion
+// sets of [Reis2008, sec. VII]): a block whose bounds the ray's height range over the block misses is
+// skipped whole; otherwise the walk descends; a cell (level 0) is tested triangle by triangle exactly as
+// one patch of programs/analytic_patch.glsl (clip, restrict by blossoming, first root, [Reis2008, sec. V]).
+// The frame cost grows with the number of blocks a ray visits (~ log of the grid size for most rays), not
+// with the patch count. The float64 reference is splinevis.terrain.raycast (a plain cell-by-cell DDA).
 #include "lib/core/raycast.glsl"
 #include "lib/core/table.glsl"
 #include "lib/simplex/bb_triangle.glsl"

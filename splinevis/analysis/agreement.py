@@ -20,7 +20,17 @@ __all__ = ["depth_agreement", "reference_hits", "hard_case_agreement", "agreemen
 
 
 def reference_hits(model, origins, directions, *, method="reference"):
-    """Float64 ray cast of any registered model (its program's twin): a :class:`~splinevis.gl.contract.RayHits`."""
+    """Float64 ray cast of any registered model (its program's twin): a :class:`~splinevis.gl.contract.RayHits`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> patch = QuarticTrianglePatch(np.full(15, 0.5), [[0, 0], [1, 0], [0, 1]])  # the plane z = 0.5
+    >>> hits = reference_hits(patch, np.array([[0.2, 0.2, 2.0]]), np.array([[0.0, 0.0, -1.0]]))
+    >>> hits.t, hits.points
+    (array([1.5]), array([[0.2, 0.2, 0.5]]))
+    """
     from ..programs import program_for
 
     return program_for(model).raycast(model, origins, directions, 0.0, method=method)
@@ -34,6 +44,15 @@ def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_it
     (GPU misses at pixels whose reference hits and whose 8 neighbours all hit: cracks), ``both``,
     ``depth_error`` and ``depth_bound`` (over pixels where both hit), ``gpu_depth``,
     ``reference_depth``, ``matrix``.
+
+    Examples
+    --------
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> r = depth_agreement(QuarticTrianglePatch.demo(), [(2.5, -3.3, 2.4), (0.05, -0.1, 0.05), (0, 0, 1)], (64, 48))
+    >>> r["pixels"], r["hit_disagree"], r["leaks"], bool(r["both"] > 500)
+    (3072, 0, 0, True)
+    >>> bool((r["depth_error"] <= r["depth_bound"]).all())  # every depth within the derived bound
+    True
     """
     from ..plotting import Plotter
     from ..programs import program_for
@@ -77,7 +96,19 @@ def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_it
 
 def hard_case_agreement(case) -> dict:
     """:func:`depth_agreement` of one :class:`~splinevis.gl.contract.HardCase` (camera, clipping range,
-    options and window size as the case says)."""
+    options and window size as the case says).
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from splinevis import programs
+    >>> case = programs.get("analytic_patch").hard_cases()[1]
+    >>> case.name
+    'grazing-1-degree'
+    >>> small = dataclasses.replace(case, window_size=(80, 60))
+    >>> agreement_failures(hard_case_agreement(small), small)
+    []
+    """
     model = case.model()
     clip = case.clipping_range
     hook = None if clip is None else (lambda pl: setattr(pl.camera, "clipping_range", clip))
@@ -88,7 +119,20 @@ def hard_case_agreement(case) -> dict:
 def agreement_failures(r: dict, case) -> list:
     """What breaks the case's limits (empty when it passes): too few hits, any leak (a crack: a GPU miss
     whose reference and all 8 neighbours hit), too many pixels where exactly one side hits, too few depths
-    within the derived bound."""
+    within the derived bound.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from splinevis.gl.contract import HardCase
+    >>> case = HardCase("example", None, None)  # default limits: 2 % hits, 0.1 % one-sided, 99.9 % within
+    >>> r = {"pixels": 1000, "both": 500, "leaks": 0, "hit_disagree": 3,
+    ...      "depth_error": np.array([1e-7, 3e-7]), "depth_bound": np.array([2e-7, 2e-7])}
+    >>> for failure in agreement_failures(r, case):
+    ...     print(failure)
+    3 pixels hit on one side only (> 0.1%)
+    50.0000% of depths within the bound (< 99.9%; worst 1.5 x bound)
+    """
     out = []
     if r["both"] < case.min_hits * r["pixels"]:
         out.append(f"only {r['both']} of {r['pixels']} pixels hit on both sides (< {case.min_hits:.1%})")

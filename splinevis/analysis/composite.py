@@ -30,7 +30,20 @@ def _classify(rgb: np.ndarray) -> np.ndarray:
 
 
 def reference_depth(model, matrix, width, height, *, method="reference"):
-    """(H, W) float64 window depth of the model by its program's float64 twin (NaN where the ray misses)."""
+    """(H, W) float64 window depth of the model by its program's float64 twin (NaN where the ray misses).
+
+    Examples
+    --------
+    With the identity as camera matrix, world coordinates are normalized device coordinates: the rays of a
+    2 x 2 window run along +z through x, y = +-0.5, and the window depth of a point is (z + 1) / 2.
+
+    >>> import numpy as np
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> ramp = QuarticTrianglePatch.from_function(lambda x, y: 0.5 * x, [[-3, -3], [3, -3], [0, 3]])
+    >>> reference_depth(ramp, np.eye(4), 2, 2).round(12)  # z = -0.25 and 0.25
+    array([[0.375, 0.625],
+           [0.375, 0.625]])
+    """
     from .agreement import reference_hits
 
     o, d = pixel_rays(matrix, width, height)
@@ -46,6 +59,20 @@ def front_surface_agreement(pl, model) -> dict:
     2 sphere), ``disagree`` (bool), ``compared`` (pixels where either says a surface is present),
     ``disagree_count``, ``agreement`` (fraction) and ``both_ways`` (pixels where the sphere is in front
     of a patch point and where the patch is in front of a sphere point, per the reference).
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> from splinevis.plotting import Plotter
+    >>> patch = QuarticTrianglePatch.demo()
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> _ = pl.add_spline(patch, **UNLIT)
+    >>> _ = pl.add_mesh(pv.Sphere(radius=0.3, center=(0.05, -0.15, 0.22)))  # cuts through the patch
+    >>> pl.camera_position = [(2.5, -3.3, 2.4), (0.05, -0.1, 0.05), (0, 0, 1)]
+    >>> r = front_surface_agreement(pl, patch)
+    >>> r["disagree_count"], min(r["both_ways"]) > 0  # each in front of the other somewhere
+    (0, True)
     """
     w, h = pl.window_size
     for actor in pl.renderer.actors.values():

@@ -2,7 +2,7 @@
 
 It proves the core (program assembly, injection, ray casting, depth compositing, effects) before the
 terrain program lands, and is exactly one terrain patch: the same restriction by blossoming
-(paper 000, eqs. (6)-(7)) and the same Newton iteration from secure starting points.
+[Reis2008, eqs. (6)-(7)] and the same Newton iteration from secure starting points [Reis2008, sec. V].
 
 The model is immutable float64 numpy and never imports VTK. :meth:`QuarticTrianglePatch.raycast` is the
 float64 twin of ``glsl/programs/analytic_patch.glsl``, step for step; with ``method="reference"`` it
@@ -66,25 +66,65 @@ class QuarticTrianglePatch:
     # -- data -----------------------------------------------------------------------------------------
     @property
     def coefficients(self) -> np.ndarray:
+        """(15,) read-only BB coefficients (heights) in ``multi_indices(4, 2)`` order.
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch(np.arange(15.0), [[0, 0], [2, 0], [0, 2]])
+        >>> p.coefficients[:4], p.coefficients.flags.writeable
+        (array([0., 1., 2., 3.]), False)
+        """
         return self._c
 
     @property
     def vertices(self) -> np.ndarray:
+        """(3, 2) read-only vertices of the domain triangle.
+
+        Examples
+        --------
+        >>> QuarticTrianglePatch(np.zeros(15), [[0, 0], [2, 0], [0, 2]]).vertices
+        array([[0., 0.],
+               [2., 0.],
+               [0., 2.]])
+        """
         return self._v
 
     @property
     def barycentric_matrix(self) -> np.ndarray:
-        """(3, 3) M with barycentric coordinates ``M @ (x, y, 1)``."""
+        """(3, 3) M with barycentric coordinates ``M @ (x, y, 1)``.
+
+        Examples
+        --------
+        >>> QuarticTrianglePatch(np.zeros(15), [[0, 0], [2, 0], [0, 2]]).barycentric_matrix
+        array([[-0.5, -0.5,  1. ],
+               [ 0.5,  0. ,  0. ],
+               [ 0. ,  0.5,  0. ]])
+        """
         return self._m
 
     @property
     def zrange(self) -> tuple:
-        """(min, max) coefficient: the surface lies in this slab (convex-hull property)."""
+        """(min, max) coefficient: the surface lies in this slab (convex-hull property).
+
+        Examples
+        --------
+        >>> QuarticTrianglePatch(np.arange(15.0), [[0, 0], [2, 0], [0, 2]]).zrange
+        (0.0, 14.0)
+        """
         return float(self._c.min()), float(self._c.max())
 
     @classmethod
     def from_function(cls, func, vertices) -> "QuarticTrianglePatch":
-        """The patch interpolating ``func(x, y)`` at the 15 domain points (quartic interpolation)."""
+        """The patch interpolating ``func(x, y)`` at the 15 domain points (quartic interpolation).
+
+        Examples
+        --------
+        Polynomials of degree <= 4 are reproduced:
+
+        >>> p = QuarticTrianglePatch.from_function(lambda x, y: x * y, [[0, 0], [1, 0], [0, 1]])
+        >>> round(float(p.evaluate([0.25, 0.5])), 12)
+        0.125
+        """
         v = as_float64_array(vertices, "vertices", ndim=2, shape_tail=(3, 2))
         idx = _simplex.multi_indices(DEGREE, 2)
         pts = (idx / DEGREE) @ v  # domain points
@@ -94,7 +134,13 @@ class QuarticTrianglePatch:
 
     @classmethod
     def demo(cls) -> "QuarticTrianglePatch":
-        """A saddle-and-bump patch over the triangle (-1, -1), (1.2, -0.9), (-0.2, 1.1)."""
+        """A saddle-and-bump patch over the triangle (-1, -1), (1.2, -0.9), (-0.2, 1.1).
+
+        Examples
+        --------
+        >>> QuarticTrianglePatch.demo().zrange
+        (-0.21643185121161518, 1.0771240190393712)
+        """
         return cls.from_function(
             lambda x, y: 0.35 * np.exp(-2.0 * (x * x + y * y)) + 0.15 * x * y - 0.05 * x * x * y * y,
             [[-1.0, -1.0], [1.2, -0.9], [-0.2, 1.1]],
@@ -102,15 +148,39 @@ class QuarticTrianglePatch:
 
     # -- evaluation -----------------------------------------------------------------------------------
     def barycentric(self, xy) -> np.ndarray:
+        """(…, 3) barycentric coordinates of points (…, 2) with respect to the domain triangle.
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch(np.zeros(15), [[0, 0], [2, 0], [0, 2]])
+        >>> p.barycentric([[0, 0], [1, 1], [0.5, 0.5]])
+        array([[1.  , 0.  , 0.  ],
+               [0.  , 0.5 , 0.5 ],
+               [0.5 , 0.25, 0.25]])
+        """
         xy = as_float64_array(xy, "xy", shape_tail=(2,))
         return xy @ self._m[:, :2].T + self._m[:, 2]
 
     def evaluate(self, xy) -> np.ndarray:
-        """f(x, y) for points (…, 2) (extrapolated outside the triangle)."""
+        """f(x, y) for points (…, 2) (extrapolated outside the triangle).
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch.from_function(lambda x, y: x * x - y, [[0, 0], [1, 0], [0, 1]])
+        >>> p.evaluate([[0.5, 0.25], [2.0, 0.0]]).round(12)  # the second point lies outside
+        array([0., 4.])
+        """
         return _simplex.de_casteljau(self._c, self.barycentric(xy), d=2)
 
     def gradient(self, xy) -> np.ndarray:
-        """(…, 2) gradient (f_x, f_y) by the derivative patch along the Cartesian directions."""
+        """(…, 2) gradient (f_x, f_y) by the derivative patch along the Cartesian directions.
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch.from_function(lambda x, y: x * y, [[0, 0], [1, 0], [0, 1]])
+        >>> p.gradient([0.25, 0.5]).round(12)  # (y, x)
+        array([0.5 , 0.25])
+        """
         lam = self.barycentric(xy)
         out = []
         for k in range(2):
@@ -120,7 +190,17 @@ class QuarticTrianglePatch:
 
     def triangulate(self, k: int):
         """The linear mesh users draw today: the triangle split into k*k sub-triangles, vertices on the
-        surface. Returns (points (M, 3), triangles (k*k, 3))."""
+        surface. Returns (points (M, 3), triangles (k*k, 3)).
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch.from_function(lambda x, y: x * y, [[0, 0], [1, 0], [0, 1]])
+        >>> points, triangles = p.triangulate(2)
+        >>> points.shape, triangles.shape
+        ((6, 3), (4, 3))
+        >>> points[4].round(12)  # the midpoint of the long edge, on the surface z = x y
+        array([0.5 , 0.5 , 0.25])
+        """
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
             raise ValueError(f"k must be a positive integer (k*k triangles), got {k!r}.")
         k = int(k)
@@ -143,7 +223,14 @@ class QuarticTrianglePatch:
 
     def proxy(self):
         """The prism over the triangle between the coefficient extremes: (6, 3) points, (8, 3) triangles
-        oriented outward."""
+        oriented outward.
+
+        Examples
+        --------
+        >>> points, triangles = QuarticTrianglePatch(np.arange(15.0), [[0, 0], [1, 0], [0, 1]]).proxy()
+        >>> points[:, 2], triangles.shape
+        (array([ 0.,  0.,  0., 14., 14., 14.]), (8, 3))
+        """
         zlo, zhi = self.zrange
         if zhi - zlo < 1e-9 * max(1.0, abs(zhi)):
             pad = 1e-6 * max(1.0, abs(zhi))  # a flat patch still needs a prism with volume
@@ -169,13 +256,22 @@ class QuarticTrianglePatch:
             Smallest admissible t (0 for perspective rays starting at the eye, -inf for parallel rays).
         method : {"reference", "bracketed", "paper"}
             ``"bracketed"`` mirrors the shader's default root finder (bracketed Newton on the convex pieces
-            between the secure starting points, ``iterations`` steps); ``"paper"`` is paper 000's
-            four-start Newton (``SV_ROOTS_PAPER``); ``"reference"`` takes the first root from
+            between the secure starting points, ``iterations`` steps); ``"paper"`` is the
+            four-start Newton of [Reis2008, sec. V] (``SV_ROOTS_PAPER``); ``"reference"`` takes the first root from
             the robust all-roots finder.
 
         Returns
         -------
         RayHits
+
+        Examples
+        --------
+        >>> p = QuarticTrianglePatch.from_function(lambda x, y: x * y, [[0, 0], [1, 0], [0, 1]])
+        >>> hits = p.raycast([[0.25, 0.5, 1.0], [2.0, 2.0, 1.0]], [0.0, 0.0, -1.0])  # the second misses
+        >>> hits.t.round(12), hits.hit
+        (array([0.875,   nan]), array([ True, False]))
+        >>> hits.normals[0].round(12)  # (-f_x, -f_y, 1)
+        array([-0.5 , -0.25,  1.  ])
         """
         check_choice(method, "method", {"reference", "bracketed", "paper"})
         o = as_float64_array(origins, "origins", shape_tail=(3,))

@@ -27,7 +27,7 @@ def patch_program(patch: QuarticTrianglePatch, style=None, *, newton_iterations:
 
     ``newton_iterations`` (1..8) is the fixed step count of ``sv_first_root`` in lib/core/roots.glsl: per
     bracketed run of the default bracketed Newton on convex pieces (bracket <= 4^-N of a piece), or
-    the Newton steps of the four-start method of [Reis2008, sec. VI] with ``roots="paper"`` (5 hide visible
+    the Newton steps of the four-start method of [Reis2008, sec. V] with ``roots="paper"`` (5 hide visible
     artifacts, 6 reach full float precision there). ``coefficients_in="texture"`` reads the
     coefficients from an RGBA32F table indexed by a per-vertex patch id instead of uniforms: the same
     image, through the plumbing large models need. ``style`` decides nothing here (the effects are
@@ -72,7 +72,17 @@ def patch_program(patch: QuarticTrianglePatch, style=None, *, newton_iterations:
 def patch_depth_bound(patch: QuarticTrianglePatch, matrix, origins, directions, t) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions``
     (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`). The shader's rays start on the far side of
-    the proxy (lib/core/raycast.glsl), so the coordinates it rounds are bounded by the proxy's extent."""
+    the proxy (lib/core/raycast.glsl), so the coordinates it rounds are bounded by the proxy's extent.
+
+    Examples
+    --------
+    >>> patch = QuarticTrianglePatch.demo()
+    >>> o, d = np.array([[0.0, 0.0, 3.0]]), np.array([[0.0, 0.0, -1.0]])
+    >>> t = patch.raycast(o, d).t
+    >>> bound = patch_depth_bound(patch, np.eye(4), o, d, t)  # identity camera: depth = (z + 1) / 2
+    >>> bound.shape, bool(0.0 < bound[0] < 1e-5)  # a few float32 roundings of the depth
+    ((1,), True)
+    """
     p = np.asarray(origins) + np.asarray(t)[..., None] * np.asarray(directions)
     extent = np.abs(patch.vertices).max(axis=0)
     return ray_depth_error_bound(lambda q: patch.gradient(q), float(np.abs(patch.coefficients).max()), matrix,

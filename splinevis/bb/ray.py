@@ -1,5 +1,5 @@
 """A ray against quartic BB triangle patches of a graph surface, vectorized: the float64 twin of
-glsl/lib/graph_patch.glsl, shared by the analytic patch and the terrain ray casters."""
+glsl/lib/simplex/graph_patch.glsl, shared by the analytic patch and the terrain ray casters."""
 
 from __future__ import annotations
 
@@ -29,12 +29,22 @@ def graph_patch_first_hit(b, lam_o, lam_d, oz, dz, ta, tb, *, margin=0.0, method
     margin : float
         Barycentric coordinates down to ``-margin`` count as inside.
     method : {"reference", "gpu", "paper"}
-        First root by the robust reference, by the shader's bracketed Newton (float64 twin), or by paper
-        000's four-start Newton (the shader with SV_ROOTS_PAPER_NEWTON).
+        First root by the robust reference, by the shader's bracketed Newton (float64 twin), or by the
+        four-start Newton of [Reis2008, sec. V] (the shader with SV_ROOTS_PAPER).
 
     Steps as in the shader: clip to the triangle and to the coefficient slab (widened by a few thousand
     ulps so a flat patch does not collapse it), restrict by blossoming, subtract the ray's height,
-    first root (paper 000, sec. VI).
+    first root [Reis2008, sec. V].
+
+    Examples
+    --------
+    Two vertical rays from height 2 down onto the plane z = 0.5, one through the centroid, one outside
+    the triangle:
+
+    >>> b = np.full((2, 15), 0.5)
+    >>> lam_o, lam_d = np.array([[1 / 3, 1 / 3, 1 / 3], [2.0, -0.5, -0.5]]), np.zeros((2, 3))
+    >>> graph_patch_first_hit(b, lam_o, lam_d, np.full(2, 2.0), np.full(2, -1.0), np.zeros(2), np.full(2, np.inf))
+    array([1.5, nan])
     """
     t0, t1 = ta.astype(np.float64).copy(), tb.astype(np.float64).copy()
     with np.errstate(divide="ignore", invalid="ignore"):

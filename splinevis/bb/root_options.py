@@ -12,7 +12,7 @@ name       method                                                               
 analytic   closed form: stable quadratic formula, trigonometric/Cardano cubic      2, 3
 bracketed  Newton on convex pieces between secure starting points, bracketed      1..4
 paper      Newton from secure starting points without a bracket: four starts for   3, 4
-           quartics [Reis2008, sec. VI], three for cubics [Kalbe2008, sec. 5.3]
+           quartics [Reis2008, sec. V], three for cubics [Kalbe2008, sec. 5.3]
 reference  companion eigenvalues + sign scan + isolation (float64 only)            1..4
 ========== ======================================================================= ==================
 """

@@ -7,8 +7,8 @@ barycentric coordinates ``lam = (lam_0, ..., lam_d)`` (``sum lam_i = 1``) as
           B^n_\\alpha(\\lambda) = \\frac{n!}{\\alpha_0! \\cdots \\alpha_d!}
           \\lambda_0^{\\alpha_0} \\cdots \\lambda_d^{\\alpha_d}
 
-(Farin, *Curves and Surfaces for CAGD*, 5th ed., ch. 5 for d = 1 and ch. 17 for triangles; Lai &
-Schumaker, *Spline Functions on Triangulations*, ch. 2 and ch. 15 for tetrahedra).
+([Farin2002, ch. 5] for d = 1 and [Farin2002, ch. 17] for triangles; [LaiSchumaker2007, ch. 2] for
+triangles and [LaiSchumaker2007, ch. 15] for tetrahedra).
 
 Coefficient layout
 ------------------
@@ -18,7 +18,7 @@ and every function is vectorized over them. Coefficient ``q`` belongs to the mul
 second, ... For d = 1 this is ``(n, 0), (n-1, 1), ..., (0, n)``, so univariate coefficient ``k`` multiplies
 ``B^n_k(t) = C(n, k) (1 - t)^(n-k) t^k`` with ``lam = (1 - t, t)``. For d = 2 and n = 4 the order is
 ``(4,0,0), (3,1,0), (3,0,1), (2,2,0), (2,1,1), (2,0,2), (1,3,0), ...`` -- the order the GLSL code in
-``glsl/lib/blossom.glsl`` and ``glsl/lib/bb_triangle.glsl`` uses.
+``glsl/lib/simplex/blossom.glsl`` and ``glsl/lib/simplex/bb_triangle.glsl`` uses.
 
 All arithmetic is float64; inputs of other dtypes are converted. Every public function validates its
 inputs (finite values, shapes, degree range, barycentric points summing to one) and raises ValueError or
@@ -64,7 +64,13 @@ _BARY_TOL = 2.0**-20
 # ----------------------------------------------------------------------------------------------------
 
 def num_coefficients(n: int, d: int) -> int:
-    """Number ``C(n + d, d)`` of BB coefficients of degree ``n`` on a ``d``-simplex."""
+    """Number ``C(n + d, d)`` of BB coefficients of degree ``n`` on a ``d``-simplex.
+
+    Examples
+    --------
+    >>> num_coefficients(4, 2), num_coefficients(3, 3)  # a quartic triangle, a cubic tetrahedron
+    (15, 20)
+    """
     n = check_degree(n, "degree n", low=0, high=MAX_DEGREE)
     d = check_degree(d, "simplex dimension d", low=1, high=3)
     return comb(n + d, d)
@@ -147,7 +153,13 @@ def _degree_by_count(d: int) -> dict:
 
 
 def degree_of(num: int, d: int) -> int:
-    """Degree ``n`` with ``C(n + d, d) == num``; ValueError if there is none in 0..20."""
+    """Degree ``n`` with ``C(n + d, d) == num``; ValueError if there is none in 0..20.
+
+    Examples
+    --------
+    >>> degree_of(15, 2), degree_of(10, 3)
+    (4, 2)
+    """
     d = check_degree(d, "simplex dimension d", low=1, high=3)
     table = _degree_by_count(d)
     if num not in table:
@@ -252,7 +264,12 @@ def bernstein_basis(n: int, d: int, lam) -> np.ndarray:
     -------
     (..., N) ndarray
         Values in :func:`multi_indices` order. They sum to one (partition of unity) and are
-        nonnegative inside the simplex (Farin, ch. 17.2).
+        nonnegative inside the simplex [Farin2002, ch. 17.2].
+
+    Examples
+    --------
+    >>> bernstein_basis(2, 1, [0.5, 0.5])  # (1 - t)^2, 2 (1 - t) t, t^2 at t = 1/2
+    array([0.25, 0.5 , 0.25])
     """
     n = check_degree(n, "degree n", low=0, high=MAX_DEGREE)
     d = check_degree(d, "simplex dimension d", low=1, high=3)
@@ -282,10 +299,18 @@ def de_casteljau(c, lam, *, d: int) -> np.ndarray:
 
     Notes
     -----
-    ``n`` steps of ``c[a] <- sum_i lam_i c[a + e_i]`` (Farin, ch. 17.3; ch. 3 for d = 1). Inside the
+    ``n`` steps of ``c[a] <- sum_i lam_i c[a + e_i]`` [Farin2002, ch. 17.3; ch. 3 for d = 1]. Inside the
     simplex every step is a convex combination, which makes the algorithm stable: in floating point
     with unit roundoff u, ``|computed - exact| <= gamma_{3n} sum |c_a| B_a(lam)`` for d = 1 (each level
-    rounds ``1 - t``, two products and a sum), ``gamma_m = m u / (1 - m u)``.
+    rounds ``1 - t``, two products and a sum; [MainarPena1999]), ``gamma_m = m u / (1 - m u)``
+    [Higham2002, sec. 3.4].
+
+    Examples
+    --------
+    >>> de_casteljau([0.0, 0.0, 1.0], [[0.5, 0.5], [0.0, 1.0]], d=1)  # p(t) = t^2 at t = 1/2 and 1
+    array([0.25, 1.  ])
+    >>> de_casteljau([0.0, 1.0, 0.0], [0.2, 0.3, 0.5], d=2)  # a linear patch: the coordinate lam_1
+    array(0.3)
     """
     c, n, d = _check_coefficients(c, d)
     lam = _check_point(lam, d, "lam")
@@ -296,7 +321,7 @@ def blossom(c, lams, *, d: int) -> np.ndarray:
     """The blossom (polar form) ``b[lam_1, ..., lam_n]`` of BB polynomials.
 
     The blossom is the unique symmetric, multi-affine function of ``n`` points whose diagonal is the
-    polynomial: ``b[lam, ..., lam] = p(lam)`` (Farin, ch. 4 and 17.4; Ramshaw 1987). It is computed by
+    polynomial: ``b[lam, ..., lam] = p(lam)`` [Farin2002, ch. 4 and 17.4; Ramshaw1987]. It is computed by
     de Casteljau steps using a different point at each level.
 
     Parameters
@@ -312,6 +337,15 @@ def blossom(c, lams, *, d: int) -> np.ndarray:
     -------
     ndarray
         The blossom values, shape = broadcast of the leading axes.
+
+    Examples
+    --------
+    The blossom of ``p(t) = t^2`` is ``b[s, t] = s t``; its diagonal is ``p``:
+
+    >>> float(blossom([0.0, 0.0, 1.0], [[0.7, 0.3], [0.5, 0.5]], d=1))  # s = 0.3, t = 0.5
+    0.15
+    >>> float(blossom([0.0, 0.0, 1.0], [[0.5, 0.5], [0.5, 0.5]], d=1))
+    0.25
     """
     c, n, d = _check_coefficients(c, d)
     if isinstance(lams, np.ndarray) and lams.ndim >= 1:
@@ -346,8 +380,13 @@ def derivative(c, direction, *, d: int) -> np.ndarray:
     Returns
     -------
     (..., C(n - 1 + d, d)) ndarray
-        ``n * sum_i u_i c[a + e_i]`` (Farin, ch. 17.5; Lai & Schumaker, Thm. 2.15). For ``n = 0`` the
+        ``n * sum_i u_i c[a + e_i]`` [Farin2002, ch. 17.5; LaiSchumaker2007, Thm. 2.15]. For ``n = 0`` the
         derivative is the zero polynomial, returned as one zero coefficient (degree 0).
+
+    Examples
+    --------
+    >>> derivative([0.0, 0.0, 1.0], [-1, 1], d=1)  # d/dt t^2 = 2 t: linear coefficients 0, 2
+    array([0., 2.])
     """
     c, n, d = _check_coefficients(c, d)
     u = _check_point(direction, d, "direction", affine=False)
@@ -364,6 +403,15 @@ def gradient(c, *, d: int) -> np.ndarray:
     (..., d + 1, C(n - 1 + d, d)) ndarray
         Row ``i`` holds the degree ``n - 1`` coefficients ``n c[a + e_i]``; the directional derivative
         along ``u`` is ``sum_i u_i`` row ``i`` (see :func:`derivative`). For ``n = 0`` rows are one zero.
+
+    Examples
+    --------
+    >>> g = gradient([0.0, 0.0, 1.0], d=1)  # p = lam_1^2
+    >>> g
+    array([[0., 0.],
+           [0., 2.]])
+    >>> g[1] - g[0]  # u = (-1, 1): the derivative
+    array([0., 2.])
     """
     c, n, d = _check_coefficients(c, d)
     if n == 0:
@@ -375,12 +423,17 @@ def gradient(c, *, d: int) -> np.ndarray:
 def elevate(c, *, d: int) -> np.ndarray:
     """Degree elevation ``n -> n + 1`` (same polynomial).
 
-    ``c'[b] = sum_{i: b_i > 0} (b_i / (n + 1)) c[b - e_i]`` (Farin, ch. 6 for d = 1, ch. 17.6; Lai &
-    Schumaker, Thm. 2.39).
+    ``c'[b] = sum_{i: b_i > 0} (b_i / (n + 1)) c[b - e_i]`` [Farin2002, ch. 6 for d = 1, ch. 17.6;
+    LaiSchumaker2007, Thm. 2.39].
 
     Returns
     -------
     (..., C(n + 1 + d, d)) ndarray
+
+    Examples
+    --------
+    >>> elevate([0.0, 0.0, 1.0], d=1)  # t^2 as a cubic
+    array([0.        , 0.        , 0.33333333, 1.        ])
     """
     c, n, d = _check_coefficients(c, d)
     if n + 1 > MAX_DEGREE:
@@ -409,7 +462,14 @@ def reparametrize(c, vertices, *, d: int) -> np.ndarray:
     Returns
     -------
     (..., N) ndarray
-        ``c'[b] = blossom(W_0^{b_0}, ..., W_d^{b_d})`` (Farin, ch. 17.4, "blossoms and subdivision").
+        ``c'[b] = blossom(W_0^{b_0}, ..., W_d^{b_d})`` [Farin2002, ch. 17.4] ("blossoms and subdivision").
+
+    Examples
+    --------
+    ``p(t) = t^2`` over the interval [1/2, 1]:
+
+    >>> reparametrize([0.0, 0.0, 1.0], [[0.5, 0.5], [0.0, 1.0]], d=1)
+    array([0.25, 0.5 , 1.  ])
     """
     c, n, d = _check_coefficients(c, d)
     verts = list(vertices)
@@ -436,9 +496,15 @@ def subdivide(c, at, *, d: int):
     -------
     tuple of ndarray
         d = 1: ``(left, right)``, the coefficients over ``[0, t]`` and ``[t, 1]`` (the two outer edges
-        of de Casteljau's triangle, Farin ch. 3.5). d = 2, 3: ``d + 1`` arrays; entry ``i`` holds the
+        of de Casteljau's triangle, [Farin2002, ch. 3.5]). d = 2, 3: ``d + 1`` arrays; entry ``i`` holds the
         coefficients over the sub-simplex whose vertex ``i`` is replaced by ``at`` (its vertices stay in
         the original order), computed by blossoming.
+
+    Examples
+    --------
+    >>> left, right = subdivide([0.0, 0.0, 1.0], 0.5, d=1)  # t^2 over [0, 1/2] and [1/2, 1]
+    >>> left, right
+    (array([0.  , 0.  , 0.25]), array([0.25, 0.5 , 1.  ]))
     """
     c, n, d = _check_coefficients(c, d)
     eye = np.eye(d + 1)
@@ -460,8 +526,9 @@ def restrict_to_segment(c, lam0, lam1, *, d: int) -> np.ndarray:
     """Univariate BB coefficients of ``p`` along the segment from ``lam0`` to ``lam1``.
 
     ``q(s) = p((1 - s) lam0 + s lam1)`` for ``s`` in [0, 1] has coefficients
-    ``c_k = blossom(lam0^{n-k}, lam1^k)`` (Farin, ch. 17.4; the ray-segment restriction of Kalbe et
-    al., eq. (5)). This is what the ray casters compute per fragment.
+    ``c_k = blossom(lam0^{n-k}, lam1^k)`` [Farin2002, ch. 17.4]; the ray-segment restriction of
+    [Reis2008, eq. (5)] for triangles and [Kalbe2008, Fig. 10] for tetrahedra. This is what the ray casters
+    compute per fragment.
 
     Parameters
     ----------
@@ -476,6 +543,13 @@ def restrict_to_segment(c, lam0, lam1, *, d: int) -> np.ndarray:
     -------
     (..., n + 1) ndarray
         Univariate coefficients, coefficient k for ``B^n_k(s) = C(n,k) (1-s)^(n-k) s^k``.
+
+    Examples
+    --------
+    ``p = lam_1^2`` on a triangle, from vertex 0 to the midpoint of the opposite edge, is ``(s / 2)^2``:
+
+    >>> restrict_to_segment([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], [1, 0, 0], [0, 0.5, 0.5], d=2)
+    array([0.  , 0.  , 0.25])
     """
     c, n, d = _check_coefficients(c, d)
     l0 = _check_point(lam0, d, "lam0")

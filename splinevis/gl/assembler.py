@@ -36,7 +36,13 @@ BEGIN_MARKER = "// splinevis:begin "
 
 
 def glsl_root() -> Path:
-    """The directory holding the shipped GLSL sources (``glsl/`` in the repository)."""
+    """The directory holding the shipped GLSL sources (``glsl/`` in the repository).
+
+    Examples
+    --------
+    >>> (glsl_root() / "lib" / "core" / "roots.glsl").is_file()
+    True
+    """
     return Path(str(importlib.resources.files("splinevis.glsl")))
 
 
@@ -57,6 +63,14 @@ class Assembled:
         (``("<defines>", 0)`` for generated lines).
     files : tuple of str
         The files that were included, in order (what a test inspects to prove an effect was left out).
+
+    Examples
+    --------
+    >>> block = assemble('#include "lib/core/bernstein.glsl"\\n', {"SV_X": 4})
+    >>> block.name, block.defines, block.files
+    ('<string>', (('SV_X', 4),), ('lib/core/bernstein.glsl',))
+    >>> block.text.splitlines()[:2], block.origins[:2]
+    (['// splinevis:begin <string>', '#define SV_X 4'], (('<marker>', 0), ('<defines>', 0)))
     """
 
     name: str
@@ -67,7 +81,15 @@ class Assembled:
 
     def origin_in(self, full_source: str):
         """Return a function mapping a 1-based line of ``full_source`` (which contains ``text``) to
-        ``"file:line"`` or None for lines outside our block."""
+        ``"file:line"`` or None for lines outside our block.
+
+        Examples
+        --------
+        >>> block = assemble('#include "lib/core/bernstein.glsl"\\n')
+        >>> origin = block.origin_in("#version 330\\n" + block.text)  # one line before the block
+        >>> origin(1), origin(5)
+        (None, 'lib/core/bernstein.glsl:2')
+        """
         lines = full_source.splitlines()
         marker = self.text.splitlines()[0]
         try:

@@ -23,6 +23,17 @@ def pixel_rays(matrix, width: int, height: int):
         Points on the near clipping plane.
     directions : (H, W, 3) ndarray
         From the near to the far plane (not unit): ``t`` in [0, 1] spans the view frustum.
+
+    Examples
+    --------
+    With the identity matrix world coordinates are normalized device coordinates:
+
+    >>> origins, directions = pixel_rays(np.eye(4), 2, 2)
+    >>> origins[0]  # the top row: pixel centres at y = 0.5 on the near plane z = -1
+    array([[-0.5,  0.5, -1. ],
+           [ 0.5,  0.5, -1. ]])
+    >>> directions[1, 1]
+    array([0., 0., 2.])
     """
     m = as_float64_array(matrix, "matrix", ndim=2, shape_tail=(4, 4))
     inv = np.linalg.inv(m)
@@ -41,7 +52,13 @@ def pixel_rays(matrix, width: int, height: int):
 
 
 def window_depth(matrix, points) -> np.ndarray:
-    """Window depth in [0, 1] (default depth range) of world points (..., 3); NaN stays NaN."""
+    """Window depth in [0, 1] (default depth range) of world points (..., 3); NaN stays NaN.
+
+    Examples
+    --------
+    >>> window_depth(np.eye(4), [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [np.nan, np.nan, np.nan]])
+    array([0.5, 1. , nan])
+    """
     m = as_float64_array(matrix, "matrix", ndim=2, shape_tail=(4, 4))
     p = np.asarray(points, dtype=np.float64)
     h = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1) @ m.T

@@ -107,6 +107,12 @@ class HardCase:
         Largest fraction of pixels where exactly one side hits (silhouettes grazed within rounding).
     min_hits : float
         Smallest fraction of pixels where both hit: a case that shows (almost) nothing tests nothing.
+
+    Examples
+    --------
+    >>> case = HardCase("far-origin", model=lambda: None, camera=[(0, 0, 5), (0, 0, 0), (0, 1, 0)])
+    >>> case.window_size, case.depth_fraction, case.program_options
+    ((160, 120), 0.999, {})
     """
 
     name: str
@@ -121,7 +127,14 @@ class HardCase:
     min_hits: float = 0.02
 
     def camera_for(self, model) -> list:
-        """The camera position for ``model``."""
+        """The camera position for ``model``.
+
+        Examples
+        --------
+        >>> above = HardCase("above", model=lambda: 2.0, camera=lambda h: [(0, 0, h + 3), (0, 0, h), (0, 1, 0)])
+        >>> above.camera_for(above.model())
+        [(0, 0, 5.0), (0, 0, 2.0), (0, 1, 0)]
+        """
         return self.camera(model) if callable(self.camera) else self.camera
 
 
@@ -163,6 +176,19 @@ class SplineProgram:
         Names of the program options ``build`` accepts (for messages and documentation).
     description : str
         One line for listings.
+
+    Examples
+    --------
+    A mesh-kind family needs no float64 twin; a raycast family without one is refused:
+
+    >>> class Dots:
+    ...     pass
+    >>> program = SplineProgram("dots", "mesh", Dots, build=lambda model, style, *, newton_iterations: None)
+    >>> program.kind, program.newton_iterations
+    ('mesh', 8)
+    >>> SplineProgram("dots", "raycast", Dots, build=program.build)
+    Traceback (most recent call last):
+    ValueError: SplineProgram 'dots': a raycast program needs its float64 twin (reference) and its derived depth_bound; the tests compare the GPU against them.
     """
 
     name: str
@@ -193,13 +219,30 @@ class SplineProgram:
                              "(reference) and its derived depth_bound; the tests compare the GPU against them.")
 
     def accepts(self, model) -> bool:
-        """Whether this program draws ``model`` (an instance of ``model_type`` or of a subclass)."""
+        """Whether this program draws ``model`` (an instance of ``model_type`` or of a subclass).
+
+        Examples
+        --------
+        >>> program = SplineProgram("numbers", "mesh", float, build=lambda model, style, **kw: None)
+        >>> program.accepts(1.5), program.accepts("1.5")
+        (True, False)
+        """
         return isinstance(model, self.model_type)
 
     def make(self, model, style, *, newton_iterations: int | None = None, **options):
         """Call ``build`` with the program's default iteration count and the declared options only.
 
         Unknown option names raise a ``TypeError`` that lists the known ones.
+
+        Examples
+        --------
+        >>> build = lambda model, style, *, newton_iterations, size=1: (model, newton_iterations, size)
+        >>> program = SplineProgram("echo", "mesh", int, build=build, newton_iterations=6, options=("size",))
+        >>> program.make(7, None, size=3)
+        (7, 6, 3)
+        >>> program.make(7, None, colour="red")
+        Traceback (most recent call last):
+        TypeError: program 'echo' has no option 'colour'; its options: size.
         """
         unknown = sorted(set(options) - set(self.options))
         if unknown:
@@ -209,7 +252,16 @@ class SplineProgram:
         return self.build(model, style, newton_iterations=its, **options)
 
     def raycast(self, model, origins, directions, tmin=0.0, *, method: str = "reference", iterations=None) -> RayHits:
-        """The float64 twin (``reference``) with this program's default iteration count."""
+        """The float64 twin (``reference``) with this program's default iteration count.
+
+        Examples
+        --------
+        >>> from splinevis import programs
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> plane = QuarticTrianglePatch(np.full(15, 0.5), [[0, 0], [1, 0], [0, 1]])
+        >>> programs.get("analytic_patch").raycast(plane, [[0.2, 0.2, 2.0]], [[0.0, 0.0, -1.0]]).t
+        array([1.5])
+        """
         if self.reference is None:
             raise TypeError(f"program {self.name!r} ({self.kind}) has no float64 ray caster.")
         its = self.newton_iterations if iterations is None else iterations
@@ -217,7 +269,15 @@ class SplineProgram:
 
     def signature_problems(self) -> list:
         """Mismatches between the callables and the calling conventions above (empty when all is well);
-        the registry refuses a program with any."""
+        the registry refuses a program with any.
+
+        Examples
+        --------
+        >>> SplineProgram("ok", "mesh", int, build=lambda model, style, *, newton_iterations: None).signature_problems()
+        []
+        >>> SplineProgram("bad", "mesh", int, build=lambda model, colour: None).signature_problems()
+        ['build must take (model, style, ...) first, takes (model, colour)', "build must accept the keyword 'newton_iterations'"]
+        """
         problems = []
         checks = [("build", self.build, ("model", "style"), ("newton_iterations",)),
                   ("reference", self.reference, ("model", "origins", "directions", "tmin"), ("method", "iterations")),

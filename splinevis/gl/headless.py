@@ -37,7 +37,14 @@ def _loadable(name: str) -> bool:
 
 
 def backend_libraries() -> dict:
-    """Which of each backend's libraries load here, e.g. ``{"egl": {"libEGL.so.1": True, ...}, ...}``."""
+    """Which of each backend's libraries load here, e.g. ``{"egl": {"libEGL.so.1": True, ...}, ...}``.
+
+    Examples
+    --------
+    >>> libs = backend_libraries()
+    >>> sorted(libs), list(libs["osmesa"])
+    (['egl', 'osmesa'], ['libOSMesa.so.8'])
+    """
     return {b: {lib: _loadable(lib) for lib in libs} for b, libs in _LIBRARIES.items()}
 
 
@@ -55,6 +62,14 @@ def configure(backend: str | None = None) -> str:
         If the requested backend's libraries cannot be loaded, or no backend can.
     ValueError
         For an unknown backend name.
+
+    Examples
+    --------
+    >>> configure() in ("egl", "osmesa")  # keeps the choice already made (splinevis.plotting made one)
+    True
+    >>> configure("directx")
+    Traceback (most recent call last):
+    ValueError: OpenGL backend 'directx' is not known; choose 'egl' or 'osmesa' (SPLINEVIS_GL).
     """
     requested = backend or os.environ.get("SPLINEVIS_GL") or None
     if requested is None and os.environ.get("VTK_DEFAULT_OPENGL_WINDOW") in _WINDOW_CLASS.values():
@@ -81,6 +96,21 @@ def check_render_window(render_window) -> dict:
 
     Returns the :func:`gl_info`-style dict. Raises :class:`OpenGLUnavailableError` when the window is not
     a headless class we configured, or when the driver reports no renderer (VTK's silent failure).
+
+    Examples
+    --------
+    >>> import vtkmodules.vtkRenderingOpenGL2  # registers the OpenGL window classes
+    >>> from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow
+    >>> backend = configure()
+    >>> win = vtkRenderWindow()
+    >>> win.SetOffScreenRendering(True)
+    >>> win.SetSize(1, 1)
+    >>> win.AddRenderer(vtkRenderer())
+    >>> win.Render()
+    >>> info = check_render_window(win)
+    >>> info["window_class"] == _WINDOW_CLASS[backend], bool(info["renderer"])
+    (True, True)
+    >>> win.Finalize()
     """
     info = _parse_capabilities(render_window)
     info["window_class"] = render_window.GetClassName()

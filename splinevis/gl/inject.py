@@ -134,6 +134,14 @@ class capture_vtk_errors:
 
     VTK reports a failed shader compile on its output window and carries on rendering; this is how we
     turn that into a Python exception.
+
+    Examples
+    --------
+    >>> from vtkmodules.vtkCommonCore import vtkOutputWindow
+    >>> with capture_vtk_errors() as captured:
+    ...     vtkOutputWindow.GetInstance().DisplayErrorText("shader failed")
+    >>> captured.text
+    'shader failed\\n'
     """
 
     def __enter__(self):
@@ -189,6 +197,18 @@ class SplineActor:
         (captured from the program object itself).
     program_ids : set of str
         Addresses of the vtkShaderProgram objects used; equal ids mean a shared compiled program.
+
+    Examples
+    --------
+    Building the actor needs no OpenGL context (the program compiles at the first render):
+
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> from splinevis.analytic.program import patch_program
+    >>> actor = SplineActor(patch_program(QuarticTrianglePatch.demo()), Style(lights=1))
+    >>> actor.kind, actor.poly.GetNumberOfPoints(), actor.poly.GetNumberOfPolys()  # the proxy prism
+    ('raycast', 6, 8)
+    >>> actor.assembled.files[:2], actor.program_sources
+    (('lib/core/raycast.glsl', 'lib/effects/lights.glsl'), {})
     """
 
     def __init__(self, spec: ProgramSpec, style: Style, renderer=None, *, cull_front: bool | None = None,
@@ -274,7 +294,18 @@ class SplineActor:
     def set_geometry(self, points, triangles, per_vertex: dict) -> None:
         """Replace the proxy geometry and its per-vertex arrays in place (same names and widths as the
         program was built with); the compiled program, textures and uniforms are kept. This is what an
-        isovalue change costs (splinevis.volume.program.set_isovalue)."""
+        isovalue change costs (splinevis.volume.program.set_isovalue).
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> spec = patch_program(QuarticTrianglePatch.demo(), coefficients_in="texture")
+        >>> actor = make_actor(spec)
+        >>> actor.set_geometry(2 * spec.points, spec.triangles, {"sv_patch_id": np.zeros(6)})
+        >>> actor.poly.GetBounds()[:4]
+        (-2.0, 2.4, -2.0, 2.2)
+        """
         from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
         from vtkmodules.vtkCommonCore import vtkPoints
         from vtkmodules.vtkCommonDataModel import vtkCellArray
@@ -303,7 +334,18 @@ class SplineActor:
         self.poly.Modified()
 
     def set_triangles(self, triangles) -> None:
-        """Replace only the proxy triangles (indices into the current points): view-frustum culling."""
+        """Replace only the proxy triangles (indices into the current points): view-frustum culling.
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> spec = patch_program(QuarticTrianglePatch.demo())
+        >>> actor = make_actor(spec)
+        >>> actor.set_triangles(spec.triangles[:2])
+        >>> actor.poly.GetNumberOfPolys(), actor.poly.GetNumberOfPoints()
+        (2, 6)
+        """
         from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
         from vtkmodules.vtkCommonDataModel import vtkCellArray
 
@@ -315,10 +357,23 @@ class SplineActor:
         self.poly.Modified()
 
     def set_texture(self, name: str, array: np.ndarray) -> None:
-        """Replace one RGBA32F texture of the program (e.g. a coefficient table after an isovalue change)."""
+        """Replace one RGBA32F texture of the program (e.g. a coefficient table after an isovalue change).
+
+        Examples
+        --------
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> actor = make_actor(patch_program(QuarticTrianglePatch.demo(), coefficients_in="texture"))
+        >>> actor.set_texture("sv_patch_coeffs", np.zeros((1, 4, 4), dtype=np.float32))
+        >>> prop = actor.actor.GetProperty()
+        >>> prop.GetNumberOfTextures(), prop.GetTexture("sv_patch_coeffs").GetInput().GetDimensions()
+        (1, (4, 1, 1))
+        """
         tex = _float_texture(array, name)
         self._textures[name] = tex
-        self.actor.GetProperty().SetTexture(name, tex)
+        prop = self.actor.GetProperty()
+        prop.RemoveTexture(name)  # replacing in place makes VTK warn
+        prop.SetTexture(name, tex)
 
     # VTK passes the vtkShaderProgram as call data; the decorator tells the wrapper its type.
     def _on_update_shader(self, caller, event, program=None):
@@ -336,7 +391,25 @@ class SplineActor:
     _on_update_shader.CallDataType = VTK_OBJECT
 
     def camera_frame(self):
-        """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera."""
+        """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera.
+
+        Examples
+        --------
+        >>> from vtkmodules.vtkRenderingCore import vtkRenderer
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> renderer = vtkRenderer()
+        >>> camera = renderer.GetActiveCamera()
+        >>> camera.SetPosition(0, 0, 5); camera.SetFocalPoint(0, 0, 0); camera.SetViewUp(0, 1, 0)
+        >>> eye, view, parallel, rotation = make_actor(patch_program(QuarticTrianglePatch.demo()),
+        ...                                            renderer=renderer).camera_frame()
+        >>> eye, view, parallel
+        (array([0., 0., 5.]), array([ 0.,  0., -1.]), False)
+        >>> rotation
+        array([[1., 0., 0.],
+               [0., 1., 0.],
+               [0., 0., 1.]])
+        """
         cam = self.renderer.GetActiveCamera()
         eye = np.array(cam.GetPosition(), dtype=np.float64) - self.offset  # model frame (double precision)
         focal = np.array(cam.GetFocalPoint(), dtype=np.float64) - self.offset
@@ -358,7 +431,19 @@ class SplineActor:
         return (su, sv, (mx0 - ex0) / (ex1 - ex0), (my0 - ey0) / (ey1 - ey0))
 
     def frame_uniforms(self) -> dict:
-        """All uniforms for the next frame: camera, lights, spec, style and extras."""
+        """All uniforms for the next frame: camera, lights, spec, style and extras.
+
+        Examples
+        --------
+        Without a renderer only the spec's and the style's uniforms (no camera, no lights):
+
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> actor = make_actor(patch_program(QuarticTrianglePatch.demo(), newton_iterations=5))
+        >>> u = actor.frame_uniforms()
+        >>> u["sv_newton_iterations"], u["sv_color"], "sv_eye_mc" in u
+        (5, (0.8235294117647058, 0.7058823529411765, 0.5490196078431373), False)
+        """
         u = {}
         if self.renderer is not None:
             eye, view, parallel, world_from_cam = self.camera_frame()
@@ -379,5 +464,14 @@ class SplineActor:
 
 
 def make_actor(spec: ProgramSpec, style: Style | None = None, renderer=None) -> SplineActor:
-    """Build a :class:`SplineActor` for ``spec`` shaded with ``style`` (default ``Style()``)."""
+    """Build a :class:`SplineActor` for ``spec`` shaded with ``style`` (default ``Style()``).
+
+    Examples
+    --------
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> from splinevis.analytic.program import patch_program
+    >>> actor = make_actor(patch_program(QuarticTrianglePatch.demo()))
+    >>> actor.style == Style(), bool(actor.actor.GetProperty().GetFrontfaceCulling())  # drawn from the far side
+    (True, True)
+    """
     return SplineActor(spec, style if style is not None else Style(), renderer)

@@ -48,6 +48,17 @@ def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", 
 
     Returns the vtkActor. (A vtkOpenGLPolyDataMapper of our own: pyvista's DataSetMapper renders through
     an internal mapper whose shader events it does not forward.)
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> from splinevis.plotting import Plotter
+    >>> pl = Plotter(off_screen=True, window_size=(48, 48))
+    >>> actor = add_mesh_with_reflection_lines(pl, pv.Sphere(), 8)
+    >>> image = pl.screenshot()
+    >>> actor.GetMapper().GetClassName(), image.shape, int(image.std()) > 10  # striped, not flat
+    ('vtkOpenGLPolyDataMapper', (48, 48, 3), True)
+    >>> pl.close()
     """
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkCommand
@@ -103,6 +114,20 @@ def add_mesh_with_effects(plotter, mesh, style, *, name=None):
 
     Effects a mesh cannot show yet (textures, environment maps, isophotes, output modes) raise a
     ``ValueError`` naming them, instead of being dropped silently.
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> from splinevis import Style
+    >>> from splinevis.plotting import Plotter
+    >>> pl = Plotter(off_screen=True, window_size=(48, 48))
+    >>> actor = add_mesh_with_effects(pl, pv.Sphere(), Style(lights=1, opacity=0.5))
+    >>> actor.GetProperty().GetOpacity()
+    0.5
+    >>> add_mesh_with_effects(pl, pv.Sphere(), Style(output="normals"))
+    Traceback (most recent call last):
+    ValueError: a mesh-drawing program cannot show the effects normals yet; it shows lights, reflection_lines, transparency. Remove them from the Style.
+    >>> pl.close()
     """
     unsupported = sorted(set(style.effect_set()) - MESH_EFFECTS)
     if unsupported:

@@ -47,6 +47,14 @@ class ProgramSpec:
         World position of the model frame's origin. Model coordinates (``points``, everything the
         shader sees) are world minus ``offset``; VTK composes the translation in double precision, so
         UTM-sized coordinates never reach float32.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> box = ProgramSpec("box", "programs/box.glsl", np.zeros((8, 3)), np.zeros((12, 3), dtype=int),
+    ...                   uniforms={"sv_size": 2.0}, offset=(5e5, 5e6, 0.0))
+    >>> box.defines, box.uniforms, box.offset
+    ({}, {'sv_size': 2.0}, (500000.0, 5000000.0, 0.0))
     """
 
     name: str

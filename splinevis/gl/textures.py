@@ -30,6 +30,14 @@ def as_rgba32f(values, name: str = "values") -> np.ndarray:
     Returns
     -------
     (H, W, 4) float32 ndarray
+
+    Examples
+    --------
+    >>> t = as_rgba32f(np.arange(6.0).reshape(2, 3))
+    >>> t.shape, t.dtype, t[..., 0].tolist(), float(abs(t[..., 1:]).max())
+    ((2, 3, 4), dtype('float32'), [[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]], 0.0)
+    >>> as_rgba32f(t) is t  # already an RGBA32F layout: no copy
+    True
     """
     a = _as_hwc(values, name)
     if a.shape[2] == 4:
@@ -68,6 +76,16 @@ def upload_rgba32f(values, name: str = "values"):
     Returns
     -------
     moderngl.Texture
+
+    Examples
+    --------
+    >>> from splinevis.gl.context import current
+    >>> values = np.random.default_rng(0).random((2, 3, 4), dtype=np.float32)
+    >>> texture = upload_rgba32f(values)
+    >>> texture.size, bool((read_rgba32f(texture) == values).all())  # (width, height); exact round trip
+    ((3, 2), True)
+    >>> with current():
+    ...     texture.release()
     """
     data = as_rgba32f(values, name)
     _check_size(data.shape[:2], name)
@@ -83,6 +101,15 @@ def empty_rgba32f(shape):
     Returns
     -------
     moderngl.Texture
+
+    Examples
+    --------
+    >>> from splinevis.gl.context import current
+    >>> texture = empty_rgba32f((2, 3))
+    >>> texture.size, texture.components, texture.dtype
+    ((3, 2), 4, 'f4')
+    >>> with current():
+    ...     texture.release()
     """
     _check_size(shape, "texture")
     with current() as ctx:
@@ -97,6 +124,16 @@ def read_rgba32f(texture) -> np.ndarray:
     Returns
     -------
     (H, W, 4) float32 ndarray
+
+    Examples
+    --------
+    >>> from splinevis.gl.context import current
+    >>> texture = upload_rgba32f(np.full((1, 2), 0.1))  # one channel given, the others zero
+    >>> read_rgba32f(texture)
+    array([[[0.1, 0. , 0. , 0. ],
+            [0.1, 0. , 0. , 0. ]]], dtype=float32)
+    >>> with current():
+    ...     texture.release()
     """
     w, h = texture.size
     out = np.empty((h, w, 4), dtype=np.float32)
@@ -138,6 +175,16 @@ def to_vtk_image(values, *, spacing=(1.0, 1.0), origin=(0.0, 0.0), name: str = "
     Returns
     -------
     vtkImageData
+
+    Examples
+    --------
+    >>> values = np.zeros((2, 3, 4), dtype=np.float32)
+    >>> image = to_vtk_image(values, spacing=(0.5, 2.0))
+    >>> image.GetDimensions(), image.GetSpacing()
+    ((3, 2, 1), (0.5, 2.0, 1.0))
+    >>> values[1, 2, 0] = 7.0  # shared memory: texel (i, j) = (2, 1) is point 2 + 1 * 3
+    >>> image.GetPointData().GetScalars().GetTuple4(5)
+    (7.0, 0.0, 0.0, 0.0)
     """
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonDataModel import vtkImageData
@@ -172,6 +219,12 @@ def to_vtk_texture(values, **kwargs):
     Returns
     -------
     vtkTexture
+
+    Examples
+    --------
+    >>> texture = to_vtk_texture(np.ones((2, 2)))
+    >>> texture.GetInput().GetDimensions(), texture.GetInterpolate(), texture.GetMipmap()
+    ((2, 2, 1), 0, False)
     """
     from vtkmodules.vtkRenderingCore import vtkTexture
 

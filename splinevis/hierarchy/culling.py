@@ -16,7 +16,13 @@ __all__ = ["FrustumCuller", "default_level"]
 
 
 def default_level(shape) -> int:
-    """Block level theta such that the grid is about 16 blocks across its largest axis."""
+    """Block level theta such that the grid is about 16 blocks across its largest axis.
+
+    Examples
+    --------
+    >>> default_level((256, 256, 100)), default_level((10, 10, 10))  # blocks of 16^3 cells; of single cells
+    (4, 0)
+    """
     return int(max(0, np.ceil(np.log2(max(shape) / 16.0))))
 
 
@@ -71,7 +77,15 @@ class FrustumCuller:
         self.set_units(units)
 
     def set_units(self, units) -> None:
-        """Replace the proxy units (e.g. after an isovalue change); the next update re-culls."""
+        """Replace the proxy units (e.g. after an isovalue change); the next update re-culls.
+
+        Examples
+        --------
+        >>> c = FrustumCuller([[0, 0, 0]], spacing=(1, 1, 1), level=2)
+        >>> c.set_units([[40, 0, 0], [41, 3, 0], [0, 0, 0]])
+        >>> c.blocks.tolist(), c.unit_block.tolist()  # blocks of 4^3 cells, sorted
+        ([[0, 0, 0], [10, 0, 0]], [1, 1, 0])
+        """
         self.units = np.asarray(units, dtype=np.int64).reshape(-1, 3)
         self.blocks, inverse = np.unique(self.units >> self.level, axis=0, return_inverse=True)
         self.unit_block = inverse.ravel()
@@ -83,7 +97,14 @@ class FrustumCuller:
 
     def visible_blocks(self, planes: np.ndarray) -> np.ndarray:
         """Boolean mask over ``self.blocks`` for frustum ``planes`` (6, 4) in the model frame (inward normals:
-        a point p is inside when ``planes[:, :3] @ p + planes[:, 3] >= 0`` for all six)."""
+        a point p is inside when ``planes[:, :3] @ p + planes[:, 3] >= 0`` for all six).
+
+        Examples
+        --------
+        >>> c = FrustumCuller([[0, 0, 0], [40, 0, 0]], spacing=(1, 1, 1), level=2)
+        >>> c.visible_blocks(np.array([[1.0, 0, 0, -20.0]] * 6)).tolist(), c.tests  # only x >= 20
+        ([False, True], 4)
+        """
         nb = len(self.blocks)
         if nb == 0:
             return np.zeros(0, bool)
@@ -121,12 +142,30 @@ class FrustumCuller:
         return keep
 
     def visible(self, planes: np.ndarray) -> np.ndarray:
-        """Boolean mask over the units for frustum ``planes`` (model frame)."""
+        """Boolean mask over the units for frustum ``planes`` (model frame).
+
+        Examples
+        --------
+        >>> c = FrustumCuller([[0, 0, 0], [1, 0, 0], [40, 0, 0]], spacing=(1, 1, 1), level=2)
+        >>> c.visible(np.array([[-1.0, 0, 0, 10.0]] * 6)).tolist()  # only x <= 10
+        [True, True, False]
+        """
         blocks = self.visible_blocks(planes)
         return blocks[self.unit_block] if len(self.unit_block) else np.zeros(0, bool)
 
     def frustum_planes(self, renderer) -> np.ndarray:
-        """The renderer's active camera's six planes in the model frame."""
+        """The renderer's active camera's six planes in the model frame.
+
+        Examples
+        --------
+        >>> from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow
+        >>> renderer, window = vtkRenderer(), vtkRenderWindow()
+        >>> window.SetSize(100, 100); window.AddRenderer(renderer)
+        >>> renderer.GetActiveCamera().SetPosition(0, 0, 50)  # looking down -z at the origin
+        >>> planes = FrustumCuller([[0, 0, 0]], spacing=(1, 1, 1)).frustum_planes(renderer)
+        >>> planes.shape, bool((planes[:, :3] @ [0, 0, 0] + planes[:, 3] >= 0).all())  # the origin is inside
+        ((6, 4), True)
+        """
         cam = renderer.GetActiveCamera()
         w, h = renderer.GetSize()
         planes = [0.0] * 24
@@ -136,7 +175,20 @@ class FrustumCuller:
         return P
 
     def update(self, renderer) -> None:
-        """Cull for the renderer's current camera; calls ``on_change`` when the visible set changed."""
+        """Cull for the renderer's current camera; calls ``on_change`` when the visible set changed.
+
+        Examples
+        --------
+        >>> from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow
+        >>> renderer, window = vtkRenderer(), vtkRenderWindow()
+        >>> window.SetSize(100, 100); window.AddRenderer(renderer)
+        >>> renderer.GetActiveCamera().SetPosition(0, 0, 50)  # a 30 degree view: x within +-13 at z = 0
+        >>> changes = []
+        >>> c = FrustumCuller([[0, 0, 0], [40, 0, 0]], spacing=(1, 1, 1), level=2, on_change=changes.append)
+        >>> c.update(renderer); c.update(renderer)  # the second frame changes nothing
+        >>> [mask.tolist() for mask in changes], c.visible_units
+        ([[True, False]], 1)
+        """
         if self.enabled:
             visible = self.visible(self.frustum_planes(renderer))
         else:
@@ -150,7 +202,21 @@ class FrustumCuller:
             self.on_change(visible)
 
     def attach(self, renderer) -> None:
-        """Cull before every frame of ``renderer`` (a vtkRenderer StartEvent observer)."""
+        """Cull before every frame of ``renderer`` (a vtkRenderer StartEvent observer).
+
+        Examples
+        --------
+        >>> from vtkmodules.vtkCommonCore import vtkCommand
+        >>> from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow
+        >>> renderer, window = vtkRenderer(), vtkRenderWindow()
+        >>> window.SetSize(100, 100); window.AddRenderer(renderer)
+        >>> renderer.GetActiveCamera().SetPosition(0, 0, 50)
+        >>> c = FrustumCuller([[0, 0, 0], [40, 0, 0]], spacing=(1, 1, 1), level=2)
+        >>> c.attach(renderer)
+        >>> _ = renderer.InvokeEvent(vtkCommand.StartEvent)  # what every render of the window does first
+        >>> c.visible_units
+        1
+        """
         from vtkmodules.vtkCommonCore import vtkCommand
 
         self._observer = renderer.AddObserver(vtkCommand.StartEvent, lambda *_: self.update(renderer))

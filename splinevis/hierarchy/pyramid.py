@@ -67,28 +67,53 @@ class MinMaxPyramid:
 
     @property
     def depth(self) -> int:
-        """Number of levels above the cells."""
+        """Number of levels above the cells.
+
+        >>> MinMaxPyramid(np.zeros((5, 3)), np.ones((5, 3))).depth  # 5 -> 3 -> 2 -> 1 nodes per axis
+        3
+        """
         return len(self.levels) - 1
 
     @property
     def nbytes(self) -> int:
-        """Memory of all levels."""
+        """Memory of all levels.
+
+        >>> MinMaxPyramid(np.zeros((4, 4)), np.ones((4, 4))).nbytes  # (16 + 4 + 1) nodes x 2 x 8 bytes
+        336
+        """
         return int(sum(a.nbytes + b.nbytes for a, b in self.levels))
 
     @property
     def value_range(self) -> tuple:
-        """``(lo, hi)`` over all cells."""
+        """``(lo, hi)`` over all cells.
+
+        >>> MinMaxPyramid(np.array([[-1.0, 2.0]]), np.array([[0.0, 5.0]])).value_range
+        (-1.0, 5.0)
+        """
         a, b = self.levels[-1]
         return float(a.min()), float(b.max())
 
     def stacked(self, level: int) -> np.ndarray:
-        """Level ``level`` as one ``(..., 2)`` array of (lo, hi)."""
+        """Level ``level`` as one ``(..., 2)`` array of (lo, hi).
+
+        >>> lo = np.arange(12.0).reshape(3, 4)
+        >>> MinMaxPyramid(lo, lo + 1).stacked(2)  # the top node: the range of all cells
+        array([[[ 0., 12.]]])
+        """
         a, b = self.levels[level]
         return np.stack([a, b], axis=-1)
 
     def nodes(self, value: float, level: int) -> np.ndarray:
         """(n, ndim) int array indices of the nodes of ``level`` whose range contains ``value``, found by
-        descending from the top through containing nodes only (lexicographic order)."""
+        descending from the top through containing nodes only (lexicographic order).
+
+        >>> lo = np.arange(12.0).reshape(3, 4)
+        >>> p = MinMaxPyramid(lo, lo + 1)
+        >>> p.nodes(5.0, 0).tolist()  # the cells (1, 0) = [4, 5] and (1, 1) = [5, 6]
+        [[1, 0], [1, 1]]
+        >>> p.nodes(5.0, 1).tolist()  # coarser: node (0, 1) = [2, 8] holds 5.0, none of its cells does
+        [[0, 0], [0, 1]]
+        """
         if not 0 <= level <= self.depth:
             raise ValueError(f"level must be in 0..{self.depth}, got {level}.")
         v = float(value)

@@ -50,6 +50,12 @@ def source_kind(source) -> str | None:
     {"path", "vtk", "array"} or None
         ``"path"`` for a str or path-like, ``"vtk"`` for a pyvista or VTK data object, ``"array"`` for a
         numpy array, list or tuple; None for anything else (the reader raises TypeError naming it).
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> source_kind("head.nrrd"), source_kind(pv.ImageData()), source_kind([[1, 2]]), source_kind(3.0)
+    ('path', 'vtk', 'array', None)
     """
     if isinstance(source, (str, os.PathLike)):
         return "path"
@@ -91,6 +97,14 @@ def check_geometry(value, name: str, *, axes: int, positive: bool = False) -> tu
         A string or a value that is not a sequence of numbers.
     ValueError
         Wrong number of entries, a non-finite entry, or an entry <= 0 when ``positive``.
+
+    Examples
+    --------
+    >>> check_geometry(30, "spacing", axes=2, positive=True)  # one number: both axes
+    (30.0, 30.0)
+    >>> check_geometry((1, 1, 0), "spacing", axes=3, positive=True)
+    Traceback (most recent call last):
+    ValueError: spacing must be > 0 on every axis, got (1.0, 1.0, 0.0).
     """
     what, where = _GEOMETRY_WORDS[axes]
     if isinstance(value, (str, bytes)):
@@ -132,6 +146,21 @@ def freeze_grid(grid, field: str, samples: np.ndarray, *, axes: int) -> None:
         The samples, already checked (dimensions, finiteness).
     axes : {2, 3}
         Entries of ``spacing`` and ``origin``.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Grid:
+    ...     heights: np.ndarray
+    ...     spacing: tuple = (1.0, 1.0)
+    ...     origin: tuple = (0.0, 0.0)
+    ...     source: str = "numpy array"
+    ...     def __post_init__(self):
+    ...         freeze_grid(self, "heights", self.heights, axes=2)
+    >>> g = Grid([[1, 2], [3, 4]], spacing=[2, 2])
+    >>> g.heights.dtype, g.heights.flags.writeable, g.spacing
+    (dtype('float64'), False, (2.0, 2.0))
     """
     v = np.array(samples, dtype=np.float64, copy=True)
     v.flags.writeable = False
@@ -155,6 +184,13 @@ def refuse_own_geometry(spacing, origin, what: str, *, applies_to: str, allow_or
         The sources the arguments are meant for, e.g. ``"numpy arrays and raw files"``.
     allow_origin : bool
         The source has a spacing but no origin (SLC): ``origin=`` is allowed.
+
+    Examples
+    --------
+    >>> refuse_own_geometry(None, None, "dem.tif", applies_to="numpy arrays")  # nothing given: fine
+    >>> refuse_own_geometry((30, 30), None, "dem.tif", applies_to="numpy arrays")
+    Traceback (most recent call last):
+    ValueError: dem.tif carries its own spacing and origin; spacing= would override them. Drop the argument (spacing=/origin= apply to numpy arrays).
     """
     given = [n for n, v in (("spacing", spacing), ("origin", None if allow_origin else origin)) if v is not None]
     if given:
@@ -181,6 +217,11 @@ def unsupported_extension(path: Path, extensions: dict, hint: str = "") -> Value
     -------
     ValueError
         For the caller to raise.
+
+    Examples
+    --------
+    >>> print(unsupported_extension(Path("heights.xyz"), {".dem": "USGS DEM", ".tif": "GeoTIFF"}))
+    heights.xyz: extension '.xyz' is not supported; supported: .dem (USGS DEM), .tif (GeoTIFF).
     """
     return ValueError(f"{path}: extension {path.suffix!r} is not supported; supported: "
                       + ", ".join(f"{e} ({w})" for e, w in extensions.items()) + "." + hint)
@@ -202,6 +243,17 @@ def require_regular_file(path: Path, kind: str) -> None:
         ``path`` does not exist.
     ValueError
         ``path`` exists but is not a regular file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     require_regular_file(Path(folder), "height")
+    Traceback (most recent call last):
+    ValueError: ... is not a regular file.
+    >>> require_regular_file(Path("no/such/dem.tif"), "height")
+    Traceback (most recent call last):
+    FileNotFoundError: height file not found: no/such/dem.tif
     """
     if not path.exists():
         raise FileNotFoundError(f"{kind} file not found: {path}")
@@ -225,6 +277,13 @@ def check_real_dtype(arr: np.ndarray, where: str, what: str, *, note_strings: bo
         What the samples are (``"heights"``, ``"samples"``).
     note_strings : bool
         Say ``(strings)`` after a string or object dtype.
+
+    Examples
+    --------
+    >>> check_real_dtype(np.array([1, 2], dtype=np.uint16), "raw file", "samples")  # fine
+    >>> check_real_dtype(np.array(["1", "2"]), "numpy array", "heights")
+    Traceback (most recent call last):
+    TypeError: numpy array: heights must be real numbers, got dtype <U1 (strings).
     """
     if arr.dtype.kind not in "biuf":
         note = " (strings)" if note_strings and arr.dtype.kind in "USO" else ""
@@ -240,6 +299,13 @@ def check_exact_in_float64(arr: np.ndarray, where: str) -> None:
         The samples, any real dtype; only int64/uint64 are checked.
     where : str
         The source, first in the message.
+
+    Examples
+    --------
+    >>> check_exact_in_float64(np.array([2 ** 53], dtype=np.int64), "numpy array")  # still exact
+    >>> check_exact_in_float64(np.array([2 ** 60], dtype=np.int64), "numpy array")
+    Traceback (most recent call last):
+    ValueError: numpy array: int64 samples up to 1.152921504606847e+18 are not exact in float64 (|value| > 2**53); rescale them first.
     """
     if arr.dtype.kind in "iu" and arr.dtype.itemsize == 8 and arr.size:
         big = np.abs(arr.astype(np.float64)).max() if arr.dtype.kind == "i" else float(arr.max())
@@ -267,13 +333,19 @@ def step_deviation(coords: np.ndarray, eps: float) -> tuple:
         The largest relative deviation of a step from ``step`` (inf when ``step`` is 0).
     tolerance : float
         The deviation still counted as uniform: ``1e-6`` plus the rounding of the stored coordinates.
+
+    Examples
+    --------
+    >>> step, deviation, tolerance = step_deviation(np.array([0.0, 1.0, 2.0, 3.5]), 2.0 ** -52)
+    >>> step, round(deviation, 12), deviation > tolerance  # the last step is 1.5, the mean 7/6
+    (1.1666666666666667, 0.285714285714, True)
     """
     step = (coords[-1] - coords[0]) / (coords.size - 1)
     if step == 0:
         return float(step), float("inf"), 0.0
     dev = float(np.abs(np.diff(coords) - step).max() / abs(step))
     tol = 1e-6 + 8 * eps * float(np.abs(coords).max()) / abs(step)
-    return float(step), dev, tol
+    return float(step), dev, float(tol)
 
 
 def nonuniform_message(where: str, axis: str, deviation: float) -> str:
@@ -291,6 +363,11 @@ def nonuniform_message(where: str, axis: str, deviation: float) -> str:
     Returns
     -------
     str
+
+    Examples
+    --------
+    >>> nonuniform_message("grid.vtr", "x", 0.25)
+    'grid.vtr: x coordinates are not uniformly spaced (largest relative deviation of a step from the mean step: 0.25)'
     """
     return (f"{where}: {axis} coordinates are not uniformly spaced (largest relative deviation of a step from "
             f"the mean step: {deviation:.3g})")
@@ -321,6 +398,14 @@ def first_gap(missing: np.ndarray, source: str, what: str) -> tuple:
     ------
     ValueError
         Every sample is missing.
+
+    Examples
+    --------
+    >>> first_gap(np.array([[False, True], [True, False]]), "numpy array", "NaN/inf")
+    (2, (0, 1))
+    >>> first_gap(np.ones(3, dtype=bool), "dem.tif", "nodata")
+    Traceback (most recent call last):
+    ValueError: dem.tif: all 3 samples are nodata; nothing to read.
     """
     count = int(missing.sum())
     if count == missing.size:
@@ -351,6 +436,11 @@ def gap_error(source: str, count: int, size: int, what: str, position: str, valu
     -------
     ValueError
         For the caller to raise.
+
+    Examples
+    --------
+    >>> print(gap_error("numpy array", 2, 4, "NaN/inf", "row 0, column 1", float("nan"), "Pass fill='nearest'."))
+    numpy array: 2 of 4 samples are NaN/inf; the first at row 0, column 1, value nan. Pass fill='nearest'.
     """
     return ValueError(f"{source}: {count} of {size} samples are {what}; the first at {position}, value "
                       f"{value!r}. {remedy}")
@@ -373,6 +463,12 @@ def fill_nearest(values: np.ndarray, missing: np.ndarray, sampling: tuple) -> np
     -------
     ndarray
         A new array; valid samples are unchanged.
+
+    Examples
+    --------
+    >>> v = np.array([[1.0, np.nan, np.nan, 4.0]])
+    >>> fill_nearest(v, np.isnan(v), (1.0, 1.0))
+    array([[1., 1., 4., 4.]])
     """
     from scipy import ndimage
 

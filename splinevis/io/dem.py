@@ -111,6 +111,19 @@ def read_dem(path: Path, nodata) -> HeightSamples:
     HeightSamples
         Row 0 is the southern row, column = profile; ``crs`` names the planimetric system and unit,
         ``units`` the elevation unit.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from datasets_synthetic.dem_files import write_usgs_ascii_dem
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = write_usgs_ascii_dem(Path(folder) / "hill.dem", [[1, 2, 3], [4, 5, 6]], 30.0, (5e5, 5e6))
+    ...     samples = read_dem(path, None)
+    >>> samples.values, samples.spacing, samples.origin
+    (array([[1., 2., 3.],
+           [4., 5., 6.]]), (30.0, 30.0), (500000.0, 5000000.0))
+    >>> samples.crs, samples.units
+    ('UTM zone 33 (x, y in m)', 'm')
     """
     hdr = _read_dem_header(path)
     sw, nw, ne, se = hdr["corners"]

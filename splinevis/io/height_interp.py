@@ -41,6 +41,13 @@ def fill_gaps(h: np.ndarray, miss: np.ndarray, local: tuple, method: str) -> np.
     Returns
     -------
     (ny, nx) ndarray of float64
+
+    Examples
+    --------
+    >>> h = np.array([[0.0, 1.0, 2.0], [1.0, np.nan, 3.0], [2.0, 3.0, 4.0]])  # the plane x + y, one gap
+    >>> axes = (np.arange(3.0), np.arange(3.0))
+    >>> fill_gaps(h, np.isnan(h), axes, "linear")[1, 1], fill_gaps(h, np.isnan(h), axes, "nearest")[1, 1]
+    (np.float64(2.0), np.float64(1.0))
     """
     from scipy import interpolate, ndimage
 
@@ -86,6 +93,15 @@ def resample_uniform(h: np.ndarray, local: tuple, method: str) -> tuple:
     heights : ndarray of float64
         On the new grid, which starts at the same corner.
     spacing : (dx, dy) floats
+
+    Examples
+    --------
+    Columns at x = 0, 1, 3 become columns at the smallest step, x = 0, 1, 2, 3:
+
+    >>> h = np.array([[0.0, 1.0, 3.0], [0.0, 1.0, 3.0]])  # the height is x
+    >>> resample_uniform(h, (np.array([0.0, 1.0, 3.0]), np.array([0.0, 1.0])), "linear")
+    (array([[0., 1., 2., 3.],
+           [0., 1., 2., 3.]]), (1.0, 1.0))
     """
     from scipy.interpolate import RegularGridInterpolator
 

@@ -45,6 +45,14 @@ class HeightSamples:
         Non-uniform coordinates (RectilinearGrid, StructuredGrid), reoriented; uniformity is judged later.
     coord_eps : float
         Machine epsilon of the stored coordinates.
+
+    Examples
+    --------
+    >>> s = HeightSamples(np.array([[1, 2], [3, 4]]), np.zeros((2, 2), bool), (1.0, 1.0), (0.0, 0.0),
+    ...                   "dem.tif", flip_rows=True)  # stored north row first
+    >>> s.oriented(s.values)
+    array([[3, 4],
+           [1, 2]])
     """
 
     values: np.ndarray
@@ -62,7 +70,15 @@ class HeightSamples:
     coord_eps: float = float(np.finfo(np.float64).eps)
 
     def oriented(self, a):
-        """``a`` (rows, cols) in stored order, reordered south-to-north and west-to-east (contiguous)."""
+        """``a`` (rows, cols) in stored order, reordered south-to-north and west-to-east (contiguous).
+
+        Examples
+        --------
+        >>> s = HeightSamples(np.zeros((2, 3)), np.zeros((2, 3), bool), (1.0, 1.0), (0.0, 0.0), "x", flip_cols=True)
+        >>> s.oriented(np.array([[1, 2, 3], [4, 5, 6]]))
+        array([[3, 2, 1],
+               [6, 5, 4]])
+        """
         if self.flip_rows:
             a = a[::-1, :]
         if self.flip_cols:
@@ -70,7 +86,15 @@ class HeightSamples:
         return np.ascontiguousarray(a)
 
     def xy_of(self, r: int, c: int) -> tuple:
-        """World ``(x, y)`` of the stored sample at row ``r``, column ``c``."""
+        """World ``(x, y)`` of the stored sample at row ``r``, column ``c``.
+
+        Examples
+        --------
+        >>> s = HeightSamples(np.zeros((3, 2)), np.zeros((3, 2), bool), (10.0, 5.0), (100.0, 200.0), "x",
+        ...                   flip_rows=True)
+        >>> s.xy_of(0, 1)  # stored row 0 is the northern row
+        (110.0, 210.0)
+        """
         rows, cols = self.values.shape
         j = rows - 1 - r if self.flip_rows else r
         i = cols - 1 - c if self.flip_cols else c
@@ -96,6 +120,16 @@ def from_array(values, spacing, origin, nodata, source="numpy array") -> HeightS
     Returns
     -------
     HeightSamples
+
+    Examples
+    --------
+    >>> s = from_array([[1, 2], [3, -9999]], None, None, -9999)
+    >>> s.missing, s.spacing, s.origin
+    (array([[False, False],
+           [False,  True]]), (1.0, 1.0), (0.0, 0.0))
+    >>> from_array([1, 2, 3], None, None, None)
+    Traceback (most recent call last):
+    ValueError: numpy array: heights must be a 2-D array (ny, nx), got shape (3,).
     """
     arr = np.asarray(values)
     check_real_dtype(arr, source, "heights")
@@ -121,6 +155,13 @@ def missing_mask(arr: np.ndarray, nodata) -> np.ndarray:
     Returns
     -------
     ndarray of bool
+
+    Examples
+    --------
+    >>> missing_mask(np.array([1.0, np.nan, -9999.0]), -9999)
+    array([False,  True,  True])
+    >>> missing_mask(np.array([1, 255], dtype=np.uint8), 255), missing_mask(np.array([1, 255], dtype=np.uint8), 300)
+    (array([False,  True]), array([False, False]))
     """
     miss = ~np.isfinite(arr) if arr.dtype.kind == "f" else np.zeros(arr.shape, bool)
     if nodata is not None:

@@ -42,6 +42,19 @@ def read_vtk_file(path: Path, description: str, scalars, nodata) -> HeightSample
     Returns
     -------
     HeightSamples
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import pyvista as pv
+    >>> image = pv.ImageData(dimensions=(3, 2, 1), spacing=(10, 20, 1))
+    >>> image.point_data["z"] = np.arange(6.0)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     image.save(Path(folder) / "heights.vti")
+    ...     samples = read_vtk_file(Path(folder) / "heights.vti", "VTK XML ImageData", None, None)
+    >>> samples.values, samples.spacing
+    (array([[0., 1., 2.],
+           [3., 4., 5.]]), (10.0, 20.0))
     """
     import pyvista as pv
 
@@ -100,6 +113,18 @@ def from_pyvista(grid, name: str, scalars, nodata) -> HeightSamples:
     Returns
     -------
     HeightSamples
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> image = pv.ImageData(dimensions=(3, 2, 1), spacing=(10, 20, 1), origin=(5e5, 5e6, 0))
+    >>> image.point_data["z"] = np.arange(6.0)
+    >>> samples = from_pyvista(image, "pyvista.ImageData", "z", 5.0)  # 5.0 marks a gap
+    >>> samples.missing.sum(), samples.origin, samples.spacing
+    (np.int64(1), (500000.0, 5000000.0), (10.0, 20.0))
+    >>> from_pyvista(pv.ImageData(dimensions=(3, 2, 2)), "pyvista.ImageData", None, None)
+    Traceback (most recent call last):
+    ValueError: pyvista.ImageData: heights must lie on one x-y slice, dims (nx, ny, 1); got dims (3, 2, 2). ...
     """
     import pyvista as pv
 

@@ -87,6 +87,12 @@ class HeightGrid:
         Coordinate reference system if the source names one (``"EPSG:32633"``, ``"UTM zone 33"``).
     units : str or None
         Unit of the heights if the source names it (``"m"``, ``"ft"``).
+
+    Examples
+    --------
+    >>> g = HeightGrid([[1, 2, 3], [4, 5, 6]], spacing=(30.0, 10.0), origin=(5e5, 5e6), units="m")
+    >>> g.heights.dtype, g.heights.flags.writeable, g.extent
+    (dtype('float64'), False, (500000.0, 500060.0, 5000000.0, 5000010.0))
     """
 
     heights: np.ndarray
@@ -104,32 +110,59 @@ class HeightGrid:
 
     @property
     def shape(self) -> tuple:
-        """``(ny, nx)``."""
+        """``(ny, nx)``.
+
+        >>> HeightGrid(np.zeros((2, 3)), spacing=(1.0, 1.0), origin=(0.0, 0.0)).shape
+        (2, 3)
+        """
         return self.heights.shape
 
     @property
     def x(self) -> np.ndarray:
-        """(nx,) x coordinates of the columns."""
+        """(nx,) x coordinates of the columns.
+
+        >>> HeightGrid(np.zeros((2, 3)), spacing=(30.0, 10.0), origin=(100.0, 0.0)).x
+        array([100., 130., 160.])
+        """
         return self.origin[0] + np.arange(self.shape[1]) * self.spacing[0]
 
     @property
     def y(self) -> np.ndarray:
-        """(ny,) y coordinates of the rows (increasing: south to north)."""
+        """(ny,) y coordinates of the rows (increasing: south to north).
+
+        >>> HeightGrid(np.zeros((2, 3)), spacing=(30.0, 10.0), origin=(100.0, 0.0)).y
+        array([ 0., 10.])
+        """
         return self.origin[1] + np.arange(self.shape[0]) * self.spacing[1]
 
     @property
     def extent(self) -> tuple:
-        """``(xmin, xmax, ymin, ymax)`` of the sample positions."""
+        """``(xmin, xmax, ymin, ymax)`` of the sample positions.
+
+        >>> HeightGrid(np.zeros((2, 3)), spacing=(30.0, 10.0), origin=(100.0, 0.0)).extent
+        (100.0, 160.0, 0.0, 10.0)
+        """
         (ny, nx), (dx, dy), (x0, y0) = self.shape, self.spacing, self.origin
         return (x0, x0 + (nx - 1) * dx, y0, y0 + (ny - 1) * dy)
 
     @property
     def height_range(self) -> tuple:
-        """``(min, max)`` of the heights."""
+        """``(min, max)`` of the heights.
+
+        >>> HeightGrid([[3, -1], [2, 7]], spacing=(1.0, 1.0), origin=(0.0, 0.0)).height_range
+        (-1.0, 7.0)
+        """
         return (float(self.heights.min()), float(self.heights.max()))
 
     def points(self) -> np.ndarray:
-        """(ny*nx, 3) float64 sample positions ``(x, y, height)``, x varying fastest (VTK order)."""
+        """(ny*nx, 3) float64 sample positions ``(x, y, height)``, x varying fastest (VTK order).
+
+        >>> HeightGrid([[1, 2], [3, 4]], spacing=(10.0, 20.0), origin=(0.0, 0.0)).points()
+        array([[ 0.,  0.,  1.],
+               [10.,  0.,  2.],
+               [ 0., 20.,  3.],
+               [10., 20.,  4.]])
+        """
         xx, yy = np.meshgrid(self.x, self.y)
         return np.column_stack([xx.ravel(), yy.ravel(), self.heights.ravel()])
 

@@ -110,6 +110,18 @@ def read_nrrd(path: Path, scalars, component) -> VolumeSamples:
     Returns
     -------
     VolumeSamples
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from datasets_synthetic.volumes import write_volume
+    >>> from splinevis.io.volumes import VolumeGrid
+    >>> grid = VolumeGrid(np.arange(24.0).reshape(2, 3, 4), spacing=(1.0, 2.0, 3.0), origin=(0.0, 0.0, 1e6))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = write_volume(grid, Path(folder) / "ramp.nrrd", dtype="int16")
+    ...     samples = read_nrrd(Path(folder) / "ramp.nrrd", None, None)
+    >>> samples.values.dtype.name, samples.values.shape, samples.spacing, samples.origin
+    ('int16', (2, 3, 4), (1.0, 2.0, 3.0), (0.0, 0.0, 1000000.0))
     """
     f, data_offset = _nrrd_header(path)
     where = str(path)

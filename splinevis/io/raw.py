@@ -29,6 +29,11 @@ def with_byteorder(dt: np.dtype, order: str) -> np.dtype:
     Returns
     -------
     numpy.dtype
+
+    Examples
+    --------
+    >>> with_byteorder(np.dtype("int16"), "big"), with_byteorder(np.dtype(">f4"), "little")
+    (dtype('>i2'), dtype('<f4'))
     """
     return dt.newbyteorder("<" if order == "little" else ">")
 
@@ -56,6 +61,16 @@ def read_raw(path: Path, shape, dtype, byteorder, header_bytes, spacing, origin,
     Returns
     -------
     VolumeSamples
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "ct.raw"
+    ...     _ = path.write_bytes(np.arange(24, dtype=">u2").tobytes())  # big-endian uint16, x fastest
+    ...     samples = read_raw(path, (2, 3, 4), "uint16", "big", 0, (0.5, 0.5, 2.0), None, None)
+    >>> samples.values.dtype.name, int(samples.values[1, 2, 3]), samples.spacing  # read in native order
+    ('uint16', 23, (0.5, 0.5, 2.0))
     """
     missing = [n for n, v in (("shape", shape), ("dtype", dtype)) if v is None]
     if missing:

@@ -38,6 +38,12 @@ class VolumeSamples:
         Name of the array read, if the source names it.
     flips : (3,) bools
         ``flips[a]`` reverses axis ``a`` (x, y, z) of ``values``.
+
+    Examples
+    --------
+    >>> s = VolumeSamples(np.zeros((2, 3, 4), dtype=np.int16), (1.0, 1.0, 2.5), (0.0, 0.0, 0.0), "ct.raw")
+    >>> s.values.dtype, s.flips
+    (dtype('int16'), (False, False, False))
     """
 
     values: np.ndarray
@@ -67,6 +73,14 @@ class VolumeSamples:
         Returns
         -------
         VolumeSamples
+
+        Examples
+        --------
+        A z axis stored from top to bottom (step -2 from z = 10):
+
+        >>> s = VolumeSamples.from_steps(np.zeros((3, 2, 2)), (0.0, 0.0, 10.0), (1.0, 1.0, -2.0), (2, 2, 3), "x")
+        >>> s.spacing, s.origin, s.flips
+        ((1.0, 1.0, 2.0), (0.0, 0.0, 6.0), (False, False, True))
         """
         flips = tuple(bool(s < 0) for s in steps)
         origin = tuple(float(f + s * (m - 1)) if s < 0 else float(f) for f, s, m in zip(first, steps, counts))
@@ -74,7 +88,14 @@ class VolumeSamples:
                    scalars=scalars, flips=flips)
 
     def oriented(self) -> np.ndarray:
-        """``values`` with the flipped axes reversed (a view)."""
+        """``values`` with the flipped axes reversed (a view).
+
+        Examples
+        --------
+        >>> s = VolumeSamples(np.arange(8).reshape(2, 2, 2), (1.0,) * 3, (0.0,) * 3, "x", flips=(True, False, False))
+        >>> s.oriented()[0].tolist()  # x reversed
+        [[1, 0], [3, 2]]
+        """
         v = self.values
         fx, fy, fz = self.flips
         v = v[::-1 if fz else 1, ::-1 if fy else 1, ::-1 if fx else 1]
@@ -90,6 +111,13 @@ def check_samples(arr: np.ndarray, where: str) -> None:
         The samples.
     where : str
         The source, for the messages.
+
+    Examples
+    --------
+    >>> check_samples(np.array([1, 2], dtype=np.uint64), "numpy array")  # exact in float64: fine
+    >>> check_samples(np.array(["7", "8"]), "numpy array")
+    Traceback (most recent call last):
+    TypeError: numpy array: samples must be real numbers, got dtype <U1 (strings).
     """
     check_real_dtype(arr, where, "samples")
     check_exact_in_float64(arr, where)
@@ -104,6 +132,12 @@ def check_size(shape, where: str) -> None:
         ``(nz, ny, nx)``.
     where : str
         The source, for the message.
+
+    Examples
+    --------
+    >>> check_size((1, 64, 64), "scan.nrrd")
+    Traceback (most recent call last):
+    ValueError: scan.nrrd: a volume needs at least 2 samples on every axis; shape (nz, ny, nx) = (1, 64, 64) has 1 along z. A single slice is a 2-D image (see splinevis.io.read_heights).
     """
     if min(shape) < 2:
         axis = "zyx"[int(np.argmin(shape))]
@@ -134,6 +168,12 @@ def pick_component(arr: np.ndarray, ncomp: int, label: str, where: str, componen
     -------
     ndarray
         ``arr`` without its last axis.
+
+    Examples
+    --------
+    >>> v = np.array([[3.0, 4.0, 0.0], [0.0, 0.0, 2.0]])
+    >>> pick_component(v, 3, "velocity", "flow.vti", "magnitude"), pick_component(v, 3, "velocity", "flow.vti", -1)
+    (array([5., 2.]), array([0., 2.]))
     """
     if component is None:
         raise ValueError(f"{where}: array {label!r} has {ncomp} components per sample; a volume needs one. "
@@ -163,6 +203,15 @@ def from_array(arr: np.ndarray, spacing, origin, component, where: str) -> Volum
     Returns
     -------
     VolumeSamples
+
+    Examples
+    --------
+    >>> s = from_array(np.zeros((2, 3, 4, 2)), (1.0, 1.0, 2.0), None, 0, "numpy array")  # component 0
+    >>> s.values.shape, s.spacing, s.origin
+    ((2, 3, 4), (1.0, 1.0, 2.0), (0.0, 0.0, 0.0))
+    >>> from_array(np.zeros((4, 4)), None, None, None, "numpy array")
+    Traceback (most recent call last):
+    ValueError: numpy array: volume samples must be a 3-D array (nz, ny, nx), got shape (4, 4). A 2-D image is a height field: use splinevis.io.read_heights.
     """
     check_samples(arr, where)
     if arr.ndim == 4:
@@ -197,6 +246,14 @@ def axis_signs(direction: np.ndarray, where: str) -> np.ndarray:
     ------
     ValueError
         A rotation, shear or axis permutation: the spline schemes need axis-aligned grids.
+
+    Examples
+    --------
+    >>> axis_signs(np.diag([1.0, -1.0, 1.0]), "scan.mha")
+    array([ 1., -1.,  1.])
+    >>> axis_signs([[0, 1, 0], [1, 0, 0], [0, 0, 1]], "scan.mha")
+    Traceback (most recent call last):
+    ValueError: scan.mha: the direction matrix [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]] permutes the axes; ...
     """
     d = np.asarray(direction, dtype=np.float64)
     if d.shape != (3, 3) or not np.isfinite(d).all():

@@ -45,6 +45,20 @@ def read_vtk_file(path: Path, description: str):
     -------
     pyvista.DataSet
         With at least one point; not a MultiBlock.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import pyvista as pv
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     pv.ImageData(dimensions=(4, 3, 2)).save(Path(folder) / "box.vti")
+    ...     grid = read_vtk_file(Path(folder) / "box.vti", "VTK XML ImageData")
+    ...     _ = (Path(folder) / "broken.vti").write_text("<VTKFile")
+    ...     read_vtk_file(Path(folder) / "broken.vti", "VTK XML ImageData")
+    Traceback (most recent call last):
+    ValueError: ...broken.vti: could not be read as VTK XML ImageData...
+    >>> type(grid).__name__, grid.dimensions
+    ('ImageData', (4, 3, 2))
     """
     import pyvista as pv
 
@@ -120,6 +134,19 @@ def from_pyvista(grid, where: str, scalars, component) -> VolumeSamples:
     Returns
     -------
     VolumeSamples
+
+    Examples
+    --------
+    >>> import pyvista as pv
+    >>> image = pv.ImageData(dimensions=(4, 3, 2), spacing=(1.0, 2.0, 3.0))
+    >>> image.point_data["density"] = np.arange(24, dtype=np.uint8)
+    >>> image.point_data["velocity"] = np.zeros((24, 3))
+    >>> samples = from_pyvista(image, "pyvista.ImageData", "density", None)
+    >>> samples.values.shape, samples.values.dtype, samples.scalars, samples.spacing
+    ((2, 3, 4), dtype('uint8'), 'density', (1.0, 2.0, 3.0))
+    >>> from_pyvista(image, "pyvista.ImageData", "velocity", None)
+    Traceback (most recent call last):
+    ValueError: pyvista.ImageData: array 'velocity' has 3 components per sample; a volume needs one. ...
     """
     import pyvista as pv
 

@@ -145,37 +145,69 @@ class VolumeGrid:
 
     @property
     def shape(self) -> tuple:
-        """``(nz, ny, nx)``."""
+        """``(nz, ny, nx)``.
+
+        >>> VolumeGrid(np.zeros((2, 3, 4))).shape
+        (2, 3, 4)
+        """
         return self.values.shape
 
     @property
     def bounds(self) -> tuple:
-        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the sample positions (pyvista order)."""
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the sample positions (pyvista order).
+
+        >>> VolumeGrid(np.zeros((2, 3, 4)), spacing=(0.5, 1.0, 2.0), origin=(-1.0, 0.0, 10.0)).bounds
+        (-1.0, 0.5, 0.0, 2.0, 10.0, 12.0)
+        """
         (nz, ny, nx), (dx, dy, dz), (x0, y0, z0) = self.shape, self.spacing, self.origin
         return (x0, x0 + (nx - 1) * dx, y0, y0 + (ny - 1) * dy, z0, z0 + (nz - 1) * dz)
 
     @property
     def value_range(self) -> tuple:
-        """``(min, max)`` of the samples."""
+        """``(min, max)`` of the samples.
+
+        >>> VolumeGrid(np.arange(24.0).reshape(2, 3, 4) - 5).value_range
+        (-5.0, 18.0)
+        """
         return (float(self.values.min()), float(self.values.max()))
 
     def axes(self) -> tuple:
-        """``(x, y, z)``: the (nx,), (ny,), (nz,) float64 coordinates of the sample planes."""
+        """``(x, y, z)``: the (nx,), (ny,), (nz,) float64 coordinates of the sample planes.
+
+        >>> x, y, z = VolumeGrid(np.zeros((2, 3, 4)), spacing=(0.5, 1.0, 2.0), origin=(-1.0, 0.0, 10.0)).axes()
+        >>> x, z
+        (array([-1. , -0.5,  0. ,  0.5]), array([10., 12.]))
+        """
         (nz, ny, nx), (dx, dy, dz), (x0, y0, z0) = self.shape, self.spacing, self.origin
         return (x0 + np.arange(nx) * dx, y0 + np.arange(ny) * dy, z0 + np.arange(nz) * dz)
 
     def to_index(self, points) -> np.ndarray:
-        """World points ``(..., 3)`` to index-space coordinates ``(x, y, z) = (i, j, k)`` (float64)."""
+        """World points ``(..., 3)`` to index-space coordinates ``(x, y, z) = (i, j, k)`` (float64).
+
+        >>> g = VolumeGrid(np.zeros((2, 3, 4)), spacing=(0.5, 1.0, 2.0), origin=(-1.0, 0.0, 10.0))
+        >>> g.to_index([[0.0, 1.0, 11.0]])
+        array([[2. , 1. , 0.5]])
+        """
         p = np.asarray(points, dtype=np.float64)
         return (p - np.asarray(self.origin)) / np.asarray(self.spacing)
 
     def to_world(self, index_points) -> np.ndarray:
-        """Index-space coordinates ``(..., 3)`` to world points (float64)."""
+        """Index-space coordinates ``(..., 3)`` to world points (float64).
+
+        >>> g = VolumeGrid(np.zeros((2, 3, 4)), spacing=(0.5, 1.0, 2.0), origin=(-1.0, 0.0, 10.0))
+        >>> g.to_world([2.0, 1.0, 0.5])
+        array([ 0.,  1., 11.])
+        """
         q = np.asarray(index_points, dtype=np.float64)
         return np.asarray(self.origin) + q * np.asarray(self.spacing)
 
     def to_pyvista(self):
-        """A ``pyvista.ImageData`` with the samples as point data ``"values"`` (x fastest, VTK order)."""
+        """A ``pyvista.ImageData`` with the samples as point data ``"values"`` (x fastest, VTK order).
+
+        >>> image = VolumeGrid(np.arange(24.0).reshape(2, 3, 4), spacing=(0.5, 1.0, 2.0)).to_pyvista()
+        >>> image.dimensions, image.spacing, image.point_data["values"][:5].tolist()
+        ((4, 3, 2), (0.5, 1.0, 2.0), [0.0, 1.0, 2.0, 3.0, 4.0])
+        """
         import pyvista as pv
 
         img = pv.ImageData(dimensions=self.shape[::-1], spacing=self.spacing, origin=self.origin)

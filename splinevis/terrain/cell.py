@@ -57,7 +57,7 @@ def _edge_conditions(r):
     of the cell to the right (vertical edge) cover every interior edge. For triangles A, B sharing an edge,
     with B's opposite vertex e having barycentric coordinates lam w.r.t. A, the C^rho condition is
     ``c^B_beta = sum_{|g| = rho} B^rho_g(lam) c^A_{alpha0 + g}`` for every beta with beta_e = rho, where
-    alpha0 carries beta's exponents on the shared vertices (Farin, ch. 18; Lai & Schumaker, Thm. 2.28).
+    alpha0 carries beta's exponents on the shared vertices [Farin2002, ch. 18; LaiSchumaker2007, Thm. 2.28].
     """
     rels = []
     pairs = [((0, 0), 0, (0, 0), 1), ((0, 0), 0, (0, -1), 1), ((0, 0), 0, (1, 0), 1)]

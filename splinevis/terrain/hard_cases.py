@@ -20,7 +20,15 @@ __all__ = ["hard_cases", "franke_terrain"]
 
 def franke_terrain(n: int = 24, scheme: str = "C2-cubic", spacing=(1.0 / 24, 1.0 / 24), origin=(0.0, 0.0),
                    height_offset: float = 0.0, height_scale: float = 1.0) -> TerrainSpline:
-    """Franke's function [Franke1982] sampled on n x n points as a terrain spline."""
+    """Franke's function [Franke1982] sampled on (n + 1) x (n + 1) points of the unit square (n intervals per
+    axis) as a terrain spline.
+
+    Examples
+    --------
+    >>> t = franke_terrain()
+    >>> t.scheme, t.shape, t.extent
+    ('C2-cubic', (24, 24), (0.0, 1.0, 0.0, 1.0))
+    """
     from datasets_synthetic.franke import franke_grid
 
     z, _ = franke_grid(n)
@@ -60,7 +68,14 @@ def _flat(almost: bool):
 
 
 def hard_cases() -> list:
-    """The terrain's hard cases (module docstring), 400 x 300 pixels each."""
+    """The terrain's hard cases (module docstring), 400 x 300 pixels each.
+
+    Examples
+    --------
+    >>> cases = hard_cases()
+    >>> len(cases), cases[0].name, cases[0].window_size, cases[5].clipping_range
+    (10, 'oblique', (400, 300), (0.001, 5.0))
+    """
     size = (400, 300)
     grazing_z = 1.25
     flat_view = [(-6.0, -9.0, 262.0), (8.0, 8.0, 250.0), (0, 0, 1)]

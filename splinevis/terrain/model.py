@@ -26,6 +26,11 @@ def cell_barycentric(u, v, tri):
     """Barycentric coordinates (…, 3) of cell-local (u, v) in triangle ``tri`` (0 or 1, arrays allowed).
 
     T0 = [(0,0), (1,0), (1,1)]: (1 - u, u - v, v);  T1 = [(0,0), (1,1), (0,1)]: (1 - v, u, v - u).
+
+    Examples
+    --------
+    >>> cell_barycentric(0.75, 0.25, 0), cell_barycentric(0.25, 0.75, 1)
+    (array([0.25, 0.5 , 0.25]), array([0.25, 0.25, 0.5 ]))
     """
     u = np.asarray(u, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
@@ -58,6 +63,17 @@ class TerrainSpline:
     z_ref : float
         Reference height (the data mean): coefficients are stored relative to it.
     scheme : str
+
+    Examples
+    --------
+    The C1 scheme reproduces cubics, so a plane comes back exactly:
+
+    >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+    >>> t = TerrainSpline.from_heights(x + 2 * y, "C1", spacing=(10.0, 10.0), origin=(100.0, 200.0))
+    >>> t
+    TerrainSpline(scheme='C1', cells=5x4, patches=40, cell_spacing=(10.0, 10.0), origin=(100.0, 200.0), z_ref=6.5)
+    >>> round(float(t.evaluate(125.0, 215.0)), 12)  # x = 2.5, y = 1.5 in data indices
+    5.5
     """
 
     def __init__(self, coefficients, cell_spacing, origin=(0.0, 0.0), z_ref=0.0, scheme="custom", source=""):
@@ -80,6 +96,14 @@ class TerrainSpline:
 
     @classmethod
     def from_coefficients(cls, coefficients, cell_spacing=(1.0, 1.0), origin=(0.0, 0.0), z_ref=0.0):
+        """A spline from BB coefficients ``(ncy, ncx, 2, 15)`` relative to ``z_ref`` (scheme ``"custom"``).
+
+        Examples
+        --------
+        >>> t = TerrainSpline.from_coefficients(np.full((1, 2, 2, 15), 0.5), (2.0, 2.0), z_ref=10.0)
+        >>> t.shape, float(t.evaluate(1.0, 1.0)), t.scheme
+        ((1, 2), 10.5, 'custom')
+        """
         return cls(coefficients, cell_spacing, origin, z_ref, scheme="custom", source="coefficients")
 
     @classmethod
@@ -116,39 +140,73 @@ class TerrainSpline:
     # -- data -----------------------------------------------------------------------------------------
     @property
     def coefficients(self) -> np.ndarray:
+        """(ncy, ncx, 2, 15) read-only BB coefficients of T0 and T1 of every cell, relative to ``z_ref``.
+
+        >>> t = TerrainSpline.from_heights(np.zeros((4, 6)), "linear")
+        >>> t.coefficients.shape, t.coefficients.flags.writeable
+        ((3, 5, 2, 15), False)
+        """
         return self._c
 
     @property
     def shape(self) -> tuple:
-        """(ncy, ncx): number of spline cells."""
+        """(ncy, ncx): number of spline cells.
+
+        >>> TerrainSpline.from_heights(np.zeros((9, 13)), "C0").shape  # C0 cells span 4 x 4 data cells
+        (2, 3)
+        """
         return self._c.shape[:2]
 
     @property
     def num_patches(self) -> int:
+        """Number of triangle patches: two per cell.
+
+        >>> TerrainSpline.from_heights(np.zeros((4, 6)), "linear").num_patches
+        30
+        """
         return 2 * self._c.shape[0] * self._c.shape[1]
 
     @property
     def extent(self) -> tuple:
-        """(xmin, xmax, ymin, ymax) of the domain."""
+        """(xmin, xmax, ymin, ymax) of the domain.
+
+        >>> TerrainSpline.from_heights(np.zeros((4, 6)), "linear", spacing=(10.0, 5.0), origin=(100.0, 0.0)).extent
+        (100.0, 150.0, 0.0, 15.0)
+        """
         ncy, ncx = self.shape
         return (self.origin[0], self.origin[0] + ncx * self.cell_spacing[0],
                 self.origin[1], self.origin[1] + ncy * self.cell_spacing[1])
 
     @property
     def zrange(self) -> tuple:
-        """(min, max) physical height bound from the coefficients (convex hull property)."""
+        """(min, max) physical height bound from the coefficients (convex hull property).
+
+        >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+        >>> TerrainSpline.from_heights(x + 2 * y, "linear").zrange
+        (0.0, 13.0)
+        """
         return (self.z_ref + float(self._c.min()), self.z_ref + float(self._c.max()))
 
     @property
     def offset(self) -> np.ndarray:
-        """Origin of the local (model) frame: domain centre and z_ref, float64."""
+        """Origin of the local (model) frame: domain centre and z_ref, float64.
+
+        >>> TerrainSpline.from_heights(np.full((4, 6), 7.0), "linear", spacing=(10.0, 5.0), origin=(5e5, 5e6)).offset.tolist()
+        [500025.0, 5000007.5, 7.0]
+        """
         x0, x1, y0, y1 = self.extent
         return np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1), self.z_ref])
 
     @property
     def hierarchy(self) -> MinMaxPyramid:
         """The min/max quadtree of the coefficients: level 0 bounds each cell's 30 coefficients, level L the
-        blocks of 2^L x 2^L cells; the top level is a single block (built on first use)."""
+        blocks of 2^L x 2^L cells; the top level is a single block (built on first use).
+
+        >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+        >>> pyramid = TerrainSpline.from_heights(x + 2 * y, "linear").hierarchy
+        >>> pyramid.depth, pyramid.value_range  # heights relative to z_ref = 6.5
+        (3, (-6.5, 6.5))
+        """
         if self._pyramid is None:
             c = self._c.reshape(self._c.shape[0], self._c.shape[1], 30)
             self._pyramid = MinMaxPyramid(c.min(axis=-1), c.max(axis=-1))
@@ -156,7 +214,12 @@ class TerrainSpline:
 
     # -- evaluation -----------------------------------------------------------------------------------
     def to_index(self, x, y):
-        """Physical (x, y) -> index coordinates (u, v) in spline cells."""
+        """Physical (x, y) -> index coordinates (u, v) in spline cells.
+
+        >>> t = TerrainSpline.from_heights(np.zeros((4, 6)), "linear", spacing=(10.0, 5.0), origin=(100.0, 0.0))
+        >>> [float(c) for c in t.to_index(125.0, 7.5)]
+        [2.5, 1.5]
+        """
         u = (np.asarray(x, dtype=np.float64) - self.origin[0]) / self.cell_spacing[0]
         v = (np.asarray(y, dtype=np.float64) - self.origin[1]) / self.cell_spacing[1]
         return u, v
@@ -170,14 +233,26 @@ class TerrainSpline:
         return i, j, tri, lu, lv
 
     def evaluate(self, x, y) -> np.ndarray:
-        """Physical height s(x, y) (points outside the domain are extrapolated from the border cell)."""
+        """Physical height s(x, y) (points outside the domain are extrapolated from the border cell).
+
+        >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+        >>> t = TerrainSpline.from_heights(x * x - y, "C1")  # cubics are reproduced
+        >>> t.evaluate(np.array([2.5, 7.0]), np.array([1.5, 1.0])).round(12)  # the second point lies outside
+        array([ 4.75, 48.  ])
+        """
         u, v = self.to_index(x, y)
         i, j, tri, lu, lv = self._locate(u, v)
         lam = cell_barycentric(lu, lv, tri)
         return self.z_ref + _simplex.de_casteljau(self._c[j, i, tri], lam, d=2)
 
     def gradient(self, x, y) -> np.ndarray:
-        """(…, 2) physical gradient (ds/dx, ds/dy)."""
+        """(…, 2) physical gradient (ds/dx, ds/dy).
+
+        >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+        >>> t = TerrainSpline.from_heights(x + 2 * y, "C1", spacing=(10.0, 10.0))
+        >>> t.gradient(25.0, 15.0).round(12)  # per metre
+        array([0.1, 0.2])
+        """
         u, v = self.to_index(x, y)
         i, j, tri, lu, lv = self._locate(u, v)
         lam = cell_barycentric(lu, lv, tri)

@@ -28,7 +28,17 @@ MAX_LEVELS = 16
 
 def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
     """Table texture of the coefficients: 8 texels per cell, cells row after row (cell (i, j) is number
-    ``j ncx + i``), T0's 15 then T1's 15 coefficients, 2 zeros (:func:`splinevis.gl.proxies.pack_rgba32f`)."""
+    ``j ncx + i``), T0's 15 then T1's 15 coefficients, 2 zeros (:func:`splinevis.gl.proxies.pack_rgba32f`).
+
+    Examples
+    --------
+    >>> terrain = TerrainSpline.from_heights(np.arange(30.0).reshape(5, 6), "linear")
+    >>> table = coefficient_table(terrain)
+    >>> table.shape, table.dtype  # 20 cells x 8 texels, in one row of the table width
+    ((1, 8192, 4), dtype('float32'))
+    >>> bool((table[0, :8].ravel()[:30] == terrain.coefficients[0, 0].ravel()).all())
+    True
+    """
     ncy, ncx = terrain.shape
     flat = np.zeros((ncy, ncx, 32), dtype=np.float32)
     flat[..., :30] = terrain.coefficients.reshape(ncy, ncx, 30)
@@ -38,7 +48,18 @@ def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
 def hierarchy_table(terrain: TerrainSpline):
     """Table texture of the min/max quadtree, level after level (one texel per block, .rg = (min, max),
     rounded outward to float32 so each stored range still encloses the float64 coefficients), and the
-    texel offset and width (blocks per row) of each level."""
+    texel offset and width (blocks per row) of each level.
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+    >>> terrain = TerrainSpline.from_heights(x + 2 * y, "linear")  # 5 x 4 cells, z_ref = 6.5
+    >>> table, offsets, widths = hierarchy_table(terrain)
+    >>> offsets.tolist(), widths.tolist()  # levels of 5 x 4, 3 x 2, 2 x 1 and 1 x 1 blocks
+    ([0, 20, 26, 28], [5, 3, 2, 1])
+    >>> table[0, offsets[-1], :2]  # the top node: all coefficients, rounded outward
+    array([-6.5000005,  6.5000005], dtype=float32)
+    """
     levels = terrain.hierarchy.levels
     widths = np.array([lo.shape[1] for lo, _ in levels])
     sizes = np.array([lo.size for lo, _ in levels])
@@ -55,7 +76,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
     ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
-    secure starting points [Reis2008, sec. VI]); names as in :mod:`splinevis.bb.root_options`.
+    secure starting points [Reis2008, sec. V]); names as in :mod:`splinevis.bb.root_options`.
     ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
     int caps the top level (what the benchmarks use to measure the hierarchy's effect). ``style`` decides
     nothing here.
@@ -66,7 +87,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     Examples
     --------
     >>> import numpy as np
-    >>> from splinevis.terrain import TerrainSpline
+    >>> from splinevis.terrain.model import TerrainSpline
     >>> t = TerrainSpline.from_heights(np.zeros((5, 9)), "C2")
     >>> spec = terrain_program(t, hierarchy=False)
     >>> spec.uniforms["sv_top_level"], spec.textures["sv_terrain_coef"].shape
@@ -125,7 +146,18 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
 def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions`` (world): the shader
     works in the model frame (world - offset) and in index coordinates, so the rounded coordinates are
-    bounded by the terrain's extent (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`)."""
+    bounded by the terrain's extent (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`).
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+    >>> terrain = TerrainSpline.from_heights(x + 2 * y, "C1", spacing=(10.0, 10.0), origin=(100.0, 200.0))
+    >>> o, d = np.array([[125.0, 215.0, 50.0]]), np.array([[0.0, 0.0, -1.0]])
+    >>> t = raycast_terrain(terrain, o, d).t
+    >>> bound = terrain_depth_bound(terrain, np.eye(4), o, d, t)  # identity camera: depth (z + 1) / 2
+    >>> bool(0.0 < bound[0] < 1e-4)
+    True
+    """
     off = terrain.offset
     o_mc = np.asarray(origins) - off
     p = o_mc + np.asarray(t)[..., None] * np.asarray(directions)

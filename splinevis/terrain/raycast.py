@@ -4,7 +4,7 @@ The reference walks every ray cell by cell through the grid (Amanatides-Woo 2-D 
 rays: at each step every active ray sits in one cell on a parameter segment [ta, tb]. Where the ray's
 height range over the segment overlaps the cell's coefficient range (convex hull property), both
 triangles are tested: clip to the triangle, restrict the quartic to the segment by blossoming, take
-the first root (paper 000, sec. VI). The first hit along the ray wins.
+the first root [Reis2008, sec. V]. The first hit along the ray wins.
 
 This is deliberately a different traversal from the shader's min/max hierarchy, so a bug in one does
 not hide in the other.
@@ -26,6 +26,15 @@ def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="re
     """First t in [ta, tb] where the ray meets the cell's spline, else NaN. All arrays (N,); coef (N, 2, 15).
 
     The ray is given in cell-local coordinates: (lu0 + t du, lv0 + t dv) and height z0 + t dz.
+
+    Examples
+    --------
+    A vertical ray from height 2 through cell point (0.25, 0.75) (triangle T1) onto the plane 0.5:
+
+    >>> one = np.ones(1)
+    >>> first_hit_in_cell(np.full((1, 2, 15), 0.5), 0.25 * one, 0.75 * one, 2.0 * one, 0 * one, 0 * one,
+    ...                   -one, 0 * one, np.inf * one)
+    array([1.5])
     """
     best = np.full(ta.shape, np.nan)
     zero = np.zeros_like(du)
@@ -50,12 +59,22 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     method : {"reference", "bracketed", "paper"}
         Root finder on each candidate segment: the robust all-roots reference, or the shader's methods in
         float64: bracketed Newton on convex pieces, or Newton from four secure starting points
-        [Reis2008, sec. VI].
+        [Reis2008, sec. V].
 
     Returns
     -------
     RayHits
         ``t`` (NaN on a miss), surface points and normals (unnormalized, (-s_x, -s_y, 1)).
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+    >>> terrain = TerrainSpline.from_heights(x + 2 * y, "C1", spacing=(10.0, 10.0), origin=(100.0, 200.0))
+    >>> hits = raycast_terrain(terrain, [[125.0, 215.0, 50.0], [0.0, 0.0, 50.0]], [0.0, 0.0, -1.0])
+    >>> hits.t.round(9), hits.points[0].round(9)  # the second ray misses the domain
+    (array([44.5,  nan]), array([125. , 215. ,   5.5]))
+    >>> hits.normals[0].round(12)
+    array([-0.1, -0.2,  1. ])
     """
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")

@@ -1,7 +1,7 @@
 """Quartic spline terrains on the type-1 triangulation, built from a uniform grid of heights.
 
 Every scheme here sets the 15 quartic Bernstein-Bezier (BB) coefficients of each triangle directly as a
-fixed linear combination of nearby heights (a *quasi-interpolant*, eq. (4) of [Reis2008], section IV).
+fixed linear combination of nearby heights (a *quasi-interpolant*, [Reis2008, sec. IV, eq. (4)]).
 Schemes:
 
 ==========  =====================  ==========  ===========  =============================================
@@ -98,6 +98,11 @@ class TerrainInfo:
         ``(ncy, ncx)``, the first two axes of ``coef``.
     data_shape : tuple of int
         ``(ny, nx)`` of the heights.
+
+    Examples
+    --------
+    >>> terrain_coefficients(np.zeros((6, 6)), "C1")[1]
+    TerrainInfo(scheme='C1', cell_size=1, degree=4, smoothness=1, reproduces=3, cells=(5, 5), data_shape=(6, 6))
     """
 
     scheme: str
@@ -148,6 +153,14 @@ def scheme_stencil(scheme):
     for ``C0`` the corner is at ``4 * (i, j)``), ``W`` has shape ``(len(offsets), 30)``: coefficient ``q`` of
     triangle ``t`` of the cell is ``sum_s W[s, 15 t + q] * z(corner + offsets[s])``. Only offsets with a
     nonzero weight are listed.
+
+    Examples
+    --------
+    >>> offsets, W = scheme_stencil("linear")
+    >>> offsets, W.shape
+    ([(0, 0), (1, 0), (0, 1), (1, 1)], (4, 30))
+    >>> W.sum(axis=0).round(12).min(), W.sum(axis=0).round(12).max()  # every coefficient: weights sum to 1
+    (np.float64(1.0), np.float64(1.0))
     """
     check_choice(scheme, "scheme", SCHEMES)
     st = _BUILDERS[scheme]()
@@ -192,7 +205,7 @@ def terrain_coefficients(z, scheme="C1"):
     scheme : str
         One of :data:`SCHEMES`: ``"linear"`` (piecewise linear interpolant, degree-elevated), ``"C0"``
         (quartic interpolation at all domain points; needs sizes 4k + 1, see :func:`resample_for_c0`),
-        ``"C1"`` (C1 quasi-interpolant exact on cubics), ``"C2"`` (the paper's quartic box spline with the
+        ``"C1"`` (C1 quasi-interpolant exact on cubics), ``"C2"`` (the quartic box spline of [Reis2008, sec. IV] with the
         data as coefficients; smooths, exact on linear functions), ``"C2-cubic"`` (the same spline with
         cubic-exact coefficients).
 
@@ -253,6 +266,15 @@ def resample_for_c0(z):
     scale : tuple of float
         ``(sx, sy)``: old index units per new index unit. Multiply new index coordinates (and the physical
         grid spacing) by it.
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> z, scale = resample_for_c0(x ** 3 + y)  # 6 x 6 -> 9 x 9
+    >>> z.shape, scale
+    ((9, 9), (0.625, 0.625))
+    >>> round(float(z[8, 8]), 9), round(float(z[4, 4]), 9)  # cubics reproduced: x = y = 5 and 2.5
+    (130.0, 18.125)
     """
     z = _check_height_grid(z)
     ny, nx = z.shape
@@ -308,6 +330,16 @@ def evaluate(coef, info, x, y):
     T1 when ``y > x`` inside the cell, else T0; the value comes from de Casteljau's algorithm
     (:func:`splinevis.bb.simplex.de_casteljau`). Points outside ``[0, ncx * cell] x [0, ncy * cell]`` raise
     ValueError.
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> coef, info = terrain_coefficients(x ** 3 - x * y, "C1")  # cubics are reproduced
+    >>> round(float(evaluate(coef, info, 2.5, 1.5)), 9)
+    11.875
+    >>> evaluate(coef, info, 6.0, 1.0)
+    Traceback (most recent call last):
+    ValueError: point (x, y) = (6.0, 1.0) at index () lies outside the terrain's domain [0, 5] x [0, 5] (index units).
     """
     c, lam, _, _ = _locate(coef, info, x, y)
     return _bb.de_casteljau(c, lam, d=2)
@@ -317,6 +349,13 @@ def gradient(coef, info, x, y):
     """``(ds/dx, ds/dy)`` in index units at points ``(x, y)``, stacked on the last axis.
 
     On an edge the triangle chosen by :func:`evaluate` is used (a one-sided derivative for C0 splines).
+
+    Examples
+    --------
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> coef, info = terrain_coefficients(x ** 3 - x * y, "C1")
+    >>> gradient(coef, info, 2.5, 1.5).round(9)  # (3 x^2 - y, -x)
+    array([17.25, -2.5 ])
     """
     c, lam, t, h = _locate(coef, info, x, y)
     g = _bb.gradient(c, d=2)                       # (..., 3, 10): n * c[a + e_k]

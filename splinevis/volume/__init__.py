@@ -1,6 +1,6 @@
-"""Trivariate splines of volume data on the type-6 tetrahedral partition (issue 4; paper 003, Kalbe and
-Zeilfelder 2008): the quadratic super spline, the cubic C1 spline (Sorokina-Zeilfelder), the trilinear
-baseline, and an approximation study.
+"""Trivariate splines of volume data on the type-6 tetrahedral partition [Kalbe2008, sec. 3-4]: the
+quadratic super spline [Roessl2004; Nuernberger2005], the cubic C1 spline [SorokinaZeilfelder2007], the
+trilinear baseline, and an approximation study.
 
 See docs/volume-schemes.md for conventions, the derivations and what is verified.
 """

@@ -1,13 +1,12 @@
-"""Baselines for spline isosurfaces of volume data (issue 4), built with the peers' own APIs.
+"""Baselines for spline isosurfaces of volume data, built with the peers' own APIs.
 
 splinevis ray-casts the isosurface of a spline fitted to volume samples. Users today look at the same
-isosurface in one of two ways, and those are what every spline method is compared against (paper 003
-compares against trilinear ray casting and marching cubes):
+isosurface in one of two ways, and those are what every spline method is compared against ([Kalbe2008, sec. 6]
+compares against trilinear ray casting and marching cubes [LorensenCline1987]):
 
 * **Marching cubes meshes** (:func:`marching_cubes_mesh`): the triangle mesh of the isosurface of the
   piecewise-linear-along-grid-edges interpolant, from scikit-image's ``measure.marching_cubes``
-  (Lewiner et al. 2003, a Marching Cubes 33 variant) or VTK's ``vtkFlyingEdges3D`` (Schroeder et al.
-  2015) or ``vtkContourFilter`` (on image data VTK's synchronized templates), optionally after
+  ([Lewiner2003], a Marching Cubes 33 variant) or VTK's ``vtkFlyingEdges3D`` ([Schroeder2015]) or ``vtkContourFilter`` (on image data VTK's synchronized templates), optionally after
   upsampling the data 2x..4x with ``scipy.ndimage.zoom`` (a cubic B-spline interpolant by default), and
   shaded with the gradient-based vertex normals each library computes.
 * **GPU ray casting of the trilinear interpolant in isosurface blend mode**
@@ -74,6 +73,14 @@ def upsample_grid(grid, upsample: int = 1, order: int = 3, mode: str = "mirror")
     -------
     VolumeGrid
         ``grid`` itself when ``upsample == 1``.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> grid = sphere_grid(12)
+    >>> fine = upsample_grid(grid, 2)
+    >>> fine.shape, fine.spacing[0] == grid.spacing[0] / 2, bool(np.allclose(fine.values[::2, ::2, ::2], grid.values))
+    ((23, 23, 23), True, True)
     """
     from scipy import ndimage
 
@@ -173,11 +180,11 @@ def marching_cubes_mesh(grid, isovalue, *, method: str = "skimage", upsample: in
     grid : VolumeGrid
     isovalue : float
     method : {"skimage", "flying_edges", "contour"}
-        ``"skimage"``: ``skimage.measure.marching_cubes`` (Lewiner's Marching Cubes 33, skimage's
+        ``"skimage"``: ``skimage.measure.marching_cubes`` (the Marching Cubes 33 of [Lewiner2003], skimage's
         defaults: ``allow_degenerate=True``, ``step_size=1``); normals from the data gradient
         (central differences) interpolated to the vertices, mapped from skimage's index space to world
         space (divided by the spacing: skimage leaves them in index space, wrong on anisotropic grids). ``"flying_edges"``: VTK's
-        ``vtkFlyingEdges3D`` with ``ComputeNormals`` (gradient normals). ``"contour"``: VTK's
+        ``vtkFlyingEdges3D`` [Schroeder2015] with ``ComputeNormals`` (gradient normals). ``"contour"``: VTK's
         ``vtkContourFilter`` (on image data: ``vtkSynchronizedTemplates3D``) with ``ComputeNormals``.
         All place each vertex where the linear interpolant along a grid edge equals ``isovalue``.
     upsample : int in 1..4
@@ -190,7 +197,7 @@ def marching_cubes_mesh(grid, isovalue, *, method: str = "skimage", upsample: in
         counter-clockwise seen from that side.
     **method_options
         Passed to the library: keyword arguments of ``skimage.measure.marching_cubes`` (e.g.
-        ``method="lorensen"``, ``allow_degenerate=False``), or ``Set<Name>(value)`` calls on the VTK
+        ``method="lorensen"``, the classic algorithm of [LorensenCline1987], ``allow_degenerate=False``), or ``Set<Name>(value)`` calls on the VTK
         filter (e.g. ``ComputeNormals=False`` is not allowed: normals are part of the baseline).
 
     Returns
@@ -202,6 +209,15 @@ def marching_cubes_mesh(grid, isovalue, *, method: str = "skimage", upsample: in
         ``total_seconds`` and ``note`` (why a mesh is empty, else ``""``). An isovalue outside the
         data range gives an empty mesh (no exception); so does a flat volume equal to the isovalue
         when the library finds no surface there.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> mesh = marching_cubes_mesh(sphere_grid(12), 0.7)  # |x| = 0.7 on [-1, 1]^3
+    >>> mesh.n_cells, bool(np.abs(np.linalg.norm(mesh.points, axis=1) - 0.7).max() < 0.005)
+    (620, True)
+    >>> str(marching_cubes_mesh(sphere_grid(12), 5.0).field_data["note"][0])  # an empty mesh, and why
+    'isovalue 5.0 outside the data range [0.15745916432444323, 1.7320508075688772]'
     """
     import pyvista as pv
 
@@ -323,6 +339,16 @@ def vtk_isosurface_volume(grid, isovalue, *, sample_distance: float | None = Non
     -------
     vtkVolume
         ``.GetMapper()`` is the GPU mapper, ``.GetProperty()`` the volume property.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> volume = vtk_isosurface_volume(sphere_grid(12), 0.7, sample_distance=0.01)
+    >>> mapper = volume.GetMapper()
+    >>> mapper.GetClassName(), mapper.GetBlendMode() == mapper.ISOSURFACE_BLEND, round(mapper.GetSampleDistance(), 6)
+    ('vtkOpenGLGPUVolumeRayCastMapper', True, 0.01)
+    >>> volume.GetProperty().GetIsoSurfaceValues().GetValue(0)
+    0.7
     """
     from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
     from vtkmodules.vtkRenderingCore import vtkColorTransferFunction, vtkVolume, vtkVolumeProperty
@@ -385,6 +411,17 @@ def add_vtk_isosurface(plotter, grid, isovalue, *, name: str | None = None, rese
     mapper). The GPU ray caster runs after the opaque pass and stops rays at the opaque depth buffer,
     so meshes and splinevis spline actors in front hide it, and it covers those behind it. It writes
     no depth itself: ``Plotter.depth_buffer()`` shows only opaque geometry.
+
+    Examples
+    --------
+    >>> from splinevis.plotting import Plotter
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> pl = Plotter(off_screen=True, window_size=(48, 48))
+    >>> volume = add_vtk_isosurface(pl, sphere_grid(12), 0.7, reset_camera=True)
+    >>> image = pl.screenshot()
+    >>> bool((image != image[0, 0]).any(axis=-1)[24, 24]), float(pl.depth_buffer().min())  # drawn; no depth
+    (True, 1.0)
+    >>> pl.close()
     """
     vol = vtk_isosurface_volume(grid, isovalue, **kwargs)
     plotter.add_actor(vol, name=name, reset_camera=reset_camera)

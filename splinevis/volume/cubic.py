@@ -1,7 +1,7 @@
-"""Cubic C1 quasi-interpolating splines of volume data on the type-6 partition (Sorokina and Zeilfelder,
-IMA J. Numer. Anal. 27 (2007), "S31"; used on the GPU by Kalbe and Zeilfelder, paper 003, Sect. 4,
-Fig. 4 (determining set D3 and its masks) and Fig. 7 (repeated averaging); project notes
-``/work/shared/notes/spline-constructions.md``, section "Volumes"). See docs/volume-schemes.md.
+"""Cubic C1 quasi-interpolating splines of volume data on the type-6 partition ([SorokinaZeilfelder2007],
+"S31"; used on the GPU in [Kalbe2008, sec. 4, Fig. 4] (determining set D3 and its masks) and
+[Kalbe2008, Fig. 7] (repeated averaging)). The published masks were not available: they are derived below
+and checked by tests/test_volume_cubic.py. See docs/volume-schemes.md.
 
 Conventions are those of :mod:`splinevis.volume.schemes` (data point = cube centre, 27-point
 ``STENCIL``, linear-extrapolation padding); each tetrahedron carries 20 BB coefficients in
@@ -10,7 +10,7 @@ distinct cubic domain points.
 
 Derivation (:func:`derive_weights`, float64 linear algebra, < 1 s, cached)
 --------------------------------------------------------------------------
-1. Determining set D3 (56 points per cube, paper 003 Fig. 4 and Sect. 5): the 8 cube vertices, the 24
+1. Determining set D3 (56 points per cube, [Kalbe2008, sec. 5, Fig. 4]): the 8 cube vertices, the 24
    points at 1/3 and 2/3 of the 12 cube edges, and the 24 centroids of the boundary triangles
    ``[wF, u, u']``.
 2. The 216 C1 conditions across the 36 inner faces of the split determine the other 119 coefficients
@@ -21,7 +21,7 @@ Derivation (:func:`derive_weights`, float64 linear algebra, < 1 s, cached)
    under the 48 symmetries of the cube; agreement of every shared point between all cubes containing it
    (an identity in the data); support in the data within max-norm distance 1 of the point; reproduction
    of linear functions; the 4 consistency conditions as identities in the data. This system has exactly
-   one solution, and it consists of the fractions visible in paper 003 Fig. 4 (vertex: 1/8 of the 8
+   one solution, and it consists of the fractions visible in [Kalbe2008, Fig. 4] (vertex: 1/8 of the 8
    surrounding values; edge point: 5/24 for the 4 values around the edge, 1/24 for the 4 beyond the
    near vertex; triangle centroid: 13/48, 7/48, 1/32, 1/96).
 4. All 175 coefficients are then ``M @ K`` (``M`` from step 2), snapped to the multiples of 1/192 they
@@ -30,7 +30,7 @@ Derivation (:func:`derive_weights`, float64 linear algebra, < 1 s, cached)
 
 The spline reproduces the trilinear polynomials (span of 1, x, y, z, xy, yz, zx, xyz) exactly and the
 squares ``x^2`` up to the constant ``1/4`` (index space, spacing 1), so the gradients of all quadratics
-are exact: approximation order 2 for values and gradients (paper 003, Sect. 4 and 6).
+are exact: approximation order 2 for values and gradients [Kalbe2008, sec. 4 and 6].
 """
 
 from __future__ import annotations
@@ -66,7 +66,12 @@ def _idx(x):
 
 def domain_points():
     """``(points (175, 3), tet_map (24, 20))``: the distinct cubic domain points of one cube (local
-    coordinates) and, for every tetrahedron and BB coefficient, the index of its domain point."""
+    coordinates) and, for every tetrahedron and BB coefficient, the index of its domain point.
+
+    >>> points, tet_map = domain_points()
+    >>> points.shape, tet_map.shape, bool((6 * points == np.round(6 * points)).all())  # multiples of 1/6
+    ((175, 3), (24, 20), True)
+    """
     pts, tmap, _ = _domain()
     return pts.copy(), tmap.copy()
 
@@ -84,15 +89,26 @@ def _determining():
 
 
 def determining_set() -> np.ndarray:
-    """Indices (into :func:`domain_points`) of the 56 points of the determining set D3 (paper 003, Fig. 4):
-    cube vertices, edge points, centroids of the 24 boundary triangles; increasing order."""
+    """Indices (into :func:`domain_points`) of the 56 points of the determining set D3 [Kalbe2008, Fig. 4]:
+    cube vertices, edge points, centroids of the 24 boundary triangles; increasing order.
+
+    >>> points = domain_points()[0][determining_set()]
+    >>> on_faces = ((points == 0) | (points == 1)).sum(axis=1)  # 3: vertex, 2: edge point, 1: centroid
+    >>> len(points), [int((on_faces == k).sum()) for k in (3, 2, 1)]
+    (56, [8, 24, 24])
+    """
     return _determining().copy()
 
 
 def inner_face_conditions():
     """C1 conditions across the 36 inner faces: ``(A (216, 175), pairs)``, ``A @ c = 0`` for the
     coefficients ``c`` of a spline that is C1 inside the cube; rows ``6 m .. 6 m + 5`` belong to the face
-    shared by tetrahedra ``pairs[m]``."""
+    shared by tetrahedra ``pairs[m]``.
+
+    >>> A, pairs = inner_face_conditions()
+    >>> A.shape, len(pairs)
+    ((216, 175), 36)
+    """
     A, pairs = inner_face_rows(3)
     return A.copy(), list(pairs)
 
@@ -273,7 +289,7 @@ def _cube_face_residual(W):
 
 
 def determining_map():
-    """The determining-set encoding of the scheme (paper 003 sec. 5.1): ``(M (24, 20, 56), K (56, 27))`` with
+    """The determining-set encoding of the scheme [Kalbe2008, sec. 5.1]: ``(M (24, 20, 56), K (56, 27))`` with
     the 56 determining coefficients of a cube ``d = K @ data27`` (its masks, Fig. 4) and every tetrahedron's
     coefficients ``M[t] @ d`` (the inner C1 conditions solved for the other 119 points: "repeated averaging",
     Fig. 7). ``M[t] @ K`` equals :func:`splinevis.volume.schemes.tet_weights` ("cubic")[t] up to rounding."""
@@ -299,6 +315,12 @@ def derive_weights() -> dict:
         ``"square_shift"``: the constant s with spline(x^2) = x^2 + s (1/4, index space);
         ``"quadratic_reproduction_residual"``: residual of the mask system with s = 0 (> 0: exact
         reproduction of quadratics is impossible with these masks).
+
+    Examples
+    --------
+    >>> d = derive_weights()
+    >>> d["W"].shape, d["consistency_conditions"], round(d["square_shift"], 12), len(d["exact_faces"])
+    ((175, 27), 4, 0.25, 36)
     """
     W, ncons, ncls, inner_res, cube_res, pairs, shift, quad_res, _, _ = _weights()
     return {"W": W.copy(), "determining_set": _determining().copy(), "consistency_conditions": ncons,
@@ -309,5 +331,10 @@ def derive_weights() -> dict:
 
 def cubic_c1_spline(volume) -> np.ndarray:
     """BB coefficients of the cubic C1 quasi-interpolant of ``volume``:
-    ``spline_coefficients(volume, "cubic")``, shape ``(nz, ny, nx, 24, 20)``."""
+    ``spline_coefficients(volume, "cubic")``, shape ``(nz, ny, nx, 24, 20)``.
+
+    >>> c = cubic_c1_spline(np.full((3, 3, 3), 2.0))
+    >>> c.shape, bool(np.allclose(c, 2.0))
+    ((3, 3, 3, 24, 20), True)
+    """
     return _apply_point_weights(_check_volume(volume), _weights()[0], _domain()[1])

@@ -38,6 +38,12 @@ def domain_table(n):
         order), the index of its domain point.
     keys : dict
         ``2n * point`` (a tuple of ints) -> index.
+
+    Examples
+    --------
+    >>> points, tet_map, keys = domain_table(2)
+    >>> points.shape, tet_map.shape, points.flags.writeable, keys[(2, 2, 2)]  # the cube centre: index 0
+    ((65, 3), (24, 10), False, 0)
     """
     v = _tets()
     mi = bb._multi_indices(n, 3)
@@ -55,7 +61,15 @@ def domain_table(n):
 
 
 def domain_index(n, x):
-    """Index in :func:`domain_table` ``(n)`` of the domain point ``x`` (local coordinates, array_like (3,))."""
+    """Index in :func:`domain_table` ``(n)`` of the domain point ``x`` (local coordinates, array_like (3,)).
+
+    Examples
+    --------
+    >>> domain_index(2, [0.5, 0.5, 0.5]), domain_index(2, [0.0, 0.0, 0.0])  # the cube centre comes first
+    (0, 7)
+    >>> domain_table(2)[0][7]
+    array([0., 0., 0.])
+    """
     return domain_table(n)[2][tuple(int(v) for v in np.round(2 * n * np.asarray(x)))]
 
 
@@ -80,6 +94,12 @@ def inner_face_rows(n):
         order of ``b``.
     pairs : list of tuple of int
         ``pairs[m] = (t, s)``, the tetrahedra sharing face ``m``.
+
+    Examples
+    --------
+    >>> A, pairs = inner_face_rows(3)  # 6 conditions per face of a cubic
+    >>> A.shape, len(pairs), bool(np.allclose(A.sum(axis=1), 0.0))  # constants satisfy every condition
+    ((216, 175), 36, True)
     """
     v = _tets()
     npts = len(domain_table(n)[0])

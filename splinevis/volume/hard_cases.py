@@ -85,7 +85,14 @@ def _sheet():
 
 
 def hard_cases() -> list:
-    """The isosurface program's hard cases (module docstring)."""
+    """The isosurface program's hard cases (module docstring).
+
+    Examples
+    --------
+    >>> cases = hard_cases()
+    >>> len(cases), cases[0].name, cases[0].window_size, cases[1].program_options
+    (21, 'quadratic-sphere-blocks-data-analytic', (160, 120), {'encoding': 'coefficients'})
+    """
     quad, cubic = functools.partial(_sphere, "quadratic"), functools.partial(_sphere, "cubic")
     case = functools.partial(HardCase, min_hits=500 / 19200)  # at least 500 pixels of 160 x 120 show the surface
     cases = []

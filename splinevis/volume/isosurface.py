@@ -16,7 +16,15 @@ __all__ = ["Isosurface", "value_reference"]
 @dataclass
 class Isosurface:
     """The isosurface ``s = isovalue`` of a :class:`VolumeSpline`, what :meth:`splinevis.Plotter.add_spline`
-    draws. ``relevant`` is computed on first use (and is all that changes with the isovalue)."""
+    draws. ``relevant`` is computed on first use (and is all that changes with the isovalue).
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
+    >>> surface.isovalue, len(surface.relevant.cubes)
+    (0.7, 272)
+    """
 
     spline: VolumeSpline
     isovalue: float
@@ -31,17 +39,38 @@ class Isosurface:
 
     @property
     def relevant(self) -> Relevant:
+        """The cubes and tetrahedra of the current isovalue (recomputed after a change).
+
+        >>> from splinevis.volume.hard_cases import sphere_grid
+        >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)
+        >>> surface.isovalue = 0.4
+        >>> surface.relevant.isovalue, len(surface.relevant.cubes)  # a smaller sphere
+        (0.4, 80)
+        """
         if self._relevant is None or self._relevant.isovalue != self.isovalue:
             self._relevant = self.spline.relevant(self.isovalue)
         return self._relevant
 
     @property
-    def extent(self):  # texture coordinates span the volume's x/y (Style.texture_extent)
+    def extent(self):
+        """``(xmin, xmax, ymin, ymax)`` of the spline's domain: what a draped texture spans
+        (``Style.texture_extent`` is relative to it).
+
+        >>> surface = Isosurface(VolumeSpline(np.zeros((4, 4, 4)), spacing=(0.5, 1.0, 1.0)), 0.0)
+        >>> surface.extent
+        (-0.25, 1.75, -0.5, 3.5)
+        """
         b = self.spline.bounds
         return (b[0], b[1], b[2], b[3])
 
 
 def value_reference(spline: VolumeSpline) -> float:
-    """The value subtracted from the data before float32 upload (mid-range; isovalue independent)."""
+    """The value subtracted from the data before float32 upload (mid-range; isovalue independent).
+
+    Examples
+    --------
+    >>> value_reference(VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0))
+    1013.0
+    """
     lo, hi = spline.value_range
     return 0.5 * (lo + hi)

@@ -2,8 +2,8 @@
 
 The model keeps only what does not depend on an isovalue: the padded data (float64), the per-cube
 coefficient bounds and their min-max octree (:class:`~splinevis.hierarchy.MinMaxPyramid` in 3-D). For an isovalue,
-:meth:`VolumeSpline.relevant` finds the cubes and tetrahedra whose BB coefficients straddle it (paper 003,
-sec. 4: octree branches with the isovalue in ``[fmin, fmax]``, then the convex-hull test per tetrahedron).
+:meth:`VolumeSpline.relevant` finds the cubes and tetrahedra whose BB coefficients straddle it ([Kalbe2008,
+sec. 4]: octree branches with the isovalue in ``[fmin, fmax]``, then the convex-hull test per tetrahedron).
 
 Coordinates: data point ``values[k, j, i]`` sits at ``origin + (i, j, k) * spacing`` and is the centre of
 its cube, so the spline is defined on ``origin - spacing/2 .. origin + (n - 1/2) * spacing`` per axis.
@@ -33,7 +33,14 @@ MIN_SAMPLES = 3
 
 def tet_weights(scheme: str) -> np.ndarray:
     """(24, m, 27) data weights of the scheme: coefficient q of tetrahedron t of the cube at data point
-    ``(i, j, k)`` is ``sum_s W[t, q, s] * padded_data[(i, j, k) + STENCIL[s]]`` (m = 10 quadratic, 20 cubic)."""
+    ``(i, j, k)`` is ``sum_s W[t, q, s] * padded_data[(i, j, k) + STENCIL[s]]`` (m = 10 quadratic, 20 cubic).
+
+    Examples
+    --------
+    >>> W = tet_weights("cubic")
+    >>> W.shape, bool(np.allclose(W.sum(axis=-1), 1.0)), bool(W.min() >= 0)  # convex combinations of the data
+    ((24, 20, 27), True, True)
+    """
     if scheme not in SCHEME_DEGREE:
         raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
     return _schemes.tet_weights(scheme)
@@ -57,6 +64,13 @@ class Relevant:
         isovalue (or touching it).
     candidates : int, cubes the octree proposed (before the per-tetrahedron test).
     seconds : float, time taken.
+
+    Examples
+    --------
+    >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
+    >>> rel = VolumeSpline(x, "quadratic").relevant(2.5)  # the plane x = 2.5 between two slabs of cubes
+    >>> sorted(set(rel.cubes[:, 0].tolist())), len(rel.cubes), rel.candidates
+    ([2, 3], 72, 72)
     """
 
     isovalue: float
@@ -67,11 +81,16 @@ class Relevant:
 
     @property
     def num_tets(self) -> int:
+        """Number of relevant tetrahedra (set bits of all masks).
+
+        >>> Relevant(0.5, np.zeros((2, 3), np.int64), np.array([0b1011, 1 << 23]), 5, 0.0).num_tets
+        4
+        """
         return int(np.bitwise_count(self.masks).sum())
 
 
 class VolumeSpline:
-    """Quadratic or cubic spline on the type-6 partition of a volume (paper 003).
+    """Quadratic or cubic spline on the type-6 partition of a volume [Kalbe2008].
 
     Parameters
     ----------
@@ -120,32 +139,64 @@ class VolumeSpline:
     # ------------------------------------------------------------------ geometry
     @property
     def shape(self) -> tuple:
-        """``(nz, ny, nx)`` cubes (= data points)."""
+        """``(nz, ny, nx)`` cubes (= data points).
+
+        >>> VolumeSpline(np.zeros((3, 4, 5))).shape
+        (3, 4, 5)
+        """
         return self.grid.shape
 
     @property
     def spacing(self) -> np.ndarray:
+        """``(dx, dy, dz)`` of the data, float64 (world units per cube).
+
+        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 0.5, 2.0)).spacing
+        array([0.5, 0.5, 2. ])
+        """
         return np.asarray(self.grid.spacing, dtype=np.float64)
 
     @property
     def origin(self) -> np.ndarray:
+        """World position of data point (0, 0, 0), the centre of the first cube, float64.
+
+        >>> VolumeSpline(np.zeros((3, 4, 5)), origin=(5e5, 0.0, -10.0)).origin
+        array([ 5.e+05,  0.e+00, -1.e+01])
+        """
         return np.asarray(self.grid.origin, dtype=np.float64)
 
     @property
     def bounds(self) -> tuple:
-        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the spline's domain (cube faces, world)."""
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the spline's domain (cube faces, world).
+
+        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 1.0, 2.0)).bounds  # half a cube beyond the data
+        (-0.25, 2.25, -0.5, 3.5, -1.0, 5.0)
+        """
         n = np.array(self.shape[::-1], dtype=np.float64)
         lo = self.origin - 0.5 * self.spacing
         hi = self.origin + (n - 0.5) * self.spacing
-        return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+        return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
     @property
     def value_range(self) -> tuple:
+        """``(min, max)`` of the data.
+
+        >>> VolumeSpline(np.arange(27.0).reshape(3, 3, 3)).value_range
+        (0.0, 26.0)
+        """
         return self.grid.value_range
 
     # ------------------------------------------------------------------ coefficients
     def stencil_data(self, cubes) -> np.ndarray:
-        """(n, 27) padded data of the cubes' 27-point stencils (cubes as (n, 3) ``(i, j, k)``)."""
+        """(n, 27) padded data of the cubes' 27-point stencils (cubes as (n, 3) ``(i, j, k)``).
+
+        Examples
+        --------
+        >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+        >>> s = VolumeSpline(x)
+        >>> s.stencil_data([[1, 1, 1], [0, 0, 0]])[:, :3]  # x - 1, x, x + 1; the padding extrapolates linearly
+        array([[ 0.,  1.,  2.],
+               [-1.,  0.,  1.]])
+        """
         c = np.asarray(cubes, dtype=np.int64).reshape(-1, 3)
         off = _schemes.STENCIL  # (27, 3) as (x, y, z)
         i = c[:, None, 0] + 1 + off[None, :, 0]
@@ -154,7 +205,15 @@ class VolumeSpline:
         return self.padded[k, j, i]
 
     def cube_coefficients(self, cubes, *, chunk: int = 32768) -> np.ndarray:
-        """(n, 24, m) BB coefficients of the given cubes (float64), computed in chunks."""
+        """(n, 24, m) BB coefficients of the given cubes (float64), computed in chunks.
+
+        Examples
+        --------
+        >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+        >>> c = VolumeSpline(x + 2 * y + 3 * z, "cubic").cube_coefficients([[1, 2, 3]])
+        >>> c.shape, round(float(c[0, 0, 0]), 9)  # coefficient 0 of every tetrahedron: the cube centre (1, 2, 3)
+        ((1, 24, 20), 14.0)
+        """
         c = np.asarray(cubes, dtype=np.int64).reshape(-1, 3)
         W = self.weights.reshape(-1, 27).T  # (27, 24 m)
         out = np.empty((len(c), NUM_TETS, self.ncoef))
@@ -178,7 +237,15 @@ class VolumeSpline:
         return cell, t, lam
 
     def evaluate(self, points, *, gradient: bool = False):
-        """Spline values (and world gradients ``(n, 3)`` if ``gradient``) at world points ``(n, 3)``."""
+        """Spline values (and world gradients ``(n, 3)`` if ``gradient``) at world points ``(n, 3)``.
+
+        Examples
+        --------
+        >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
+        >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic", spacing=(0.5, 0.5, 1.0), origin=(10.0, 0.0, 0.0))
+        >>> s.evaluate([[11.25, 1.0, 2.5]], gradient=True)  # index (2.5, 2, 2.5); gradient per world unit
+        (array([14.]), array([[2., 4., 3.]]))
+        """
         cell, t, lam = self._locate(points)
         uc, inv = np.unique(cell, axis=0, return_inverse=True)
         coef = self.cube_coefficients(uc)[inv.ravel(), t]  # (n, m)
@@ -194,7 +261,18 @@ class VolumeSpline:
         """(n, 2) mean and Gaussian curvature of the level sets through world points (float64 twin of the
         shader's ``sv_tet_curvature``): mean = (|g|^2 tr H - g^T H g) / (2 |g|^3), gauss = g^T adj(H) g / |g|^4
         with g, H the spline's gradient and Hessian (1/r and 1/r^2 on a sphere of a field increasing
-        outwards)."""
+        outwards).
+
+        Examples
+        --------
+        The level sets of |x|^2 are spheres; both schemes reproduce its Hessian:
+
+        >>> z, y, x = np.mgrid[-1:1:11j, -1:1:11j, -1:1:11j]
+        >>> s = VolumeSpline(x ** 2 + y ** 2 + z ** 2, "cubic", spacing=(0.2,) * 3, origin=(-1.0,) * 3)
+        >>> s.curvature([[0.5, 0.0, 0.0], [0.0, 0.3, 0.4]]).round(9)  # r = 0.5: mean 2, Gaussian 4
+        array([[2., 4.],
+               [2., 4.]])
+        """
         cell, t, lam = self._locate(points)
         uc, inv = np.unique(cell, axis=0, return_inverse=True)
         coef = self.cube_coefficients(uc)[inv.ravel(), t]
@@ -223,7 +301,15 @@ class VolumeSpline:
     # ------------------------------------------------------------------ isovalue-independent structure
     def cube_ranges(self) -> tuple:
         """Per-cube ``(lo, hi)`` float32 bounds of the cube's BB coefficients (rounded outward), from the min
-        and max of its 27 data values and the scheme's negative weight mass."""
+        and max of its 27 data values and the scheme's negative weight mass.
+
+        Examples
+        --------
+        >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+        >>> lo, hi = VolumeSpline(x).cube_ranges()
+        >>> lo.shape, lo.dtype, float(lo[1, 1, 1]), float(hi[1, 1, 1])  # data 0..2, one float32 step outward
+        ((4, 4, 4), dtype('float32'), -1.401298464324817e-45, 2.000000238418579)
+        """
         P = self.padded.astype(np.float32)  # rounding is undone by the outward nextafter below
         mn, mx = _box3(P, np.minimum), _box3(P, np.maximum)
         N = _negative_mass(self.weights)
@@ -247,15 +333,29 @@ class VolumeSpline:
 
     @property
     def octree(self) -> MinMaxPyramid:
-        """The min-max octree (built on first use; independent of the isovalue)."""
+        """The min-max octree (built on first use; independent of the isovalue).
+
+        >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
+        >>> octree = VolumeSpline(x).octree
+        >>> octree.depth, octree.nodes(2.5, 1).shape  # blocks of 2^3 cubes that can hold x = 2.5
+        (3, (16, 3))
+        """
         if self._octree is None:
             self._octree = MinMaxPyramid(*self.cube_ranges())
         return self._octree
 
     def relevant(self, isovalue: float, *, chunk: int = 32768) -> Relevant:
-        """Cubes and tetrahedra that can contain the isosurface ``s = isovalue`` (paper 003, sec. 4).
+        """Cubes and tetrahedra that can contain the isosurface ``s = isovalue`` [Kalbe2008, sec. 4].
 
         An isovalue outside the data's range gives an empty result (an empty scene), not an error.
+
+        Examples
+        --------
+        >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
+        >>> s = VolumeSpline(x, "quadratic")
+        >>> rel = s.relevant(2.5)
+        >>> len(rel.cubes), rel.num_tets, len(s.relevant(100.0).cubes)
+        (72, 1152, 0)
         """
         iso = float(isovalue)
         if not np.isfinite(iso):
@@ -329,7 +429,7 @@ def _box3(P: np.ndarray, op) -> np.ndarray:
 def _read(volume, options) -> VolumeGrid:
     try:
         from ..io.volumes import read_volume
-    except ImportError:  # pragma: no cover - readers arrive with issue 4
+    except ImportError:  # pragma: no cover - a build without the volume readers
         read_volume = None
     if read_volume is not None:
         return read_volume(volume, **options)

@@ -2,8 +2,7 @@
 
 Each cube Q with centre ``vQ = (1/2, 1/2, 1/2)`` is split into 6 pyramids (apex vQ, base a face F of Q)
 and each pyramid into 4 tetrahedra ``[vQ, wF, u, u']`` with ``wF`` the centre of F and ``u, u'`` the two
-ends of one edge of F: 24 tetrahedra in all (Nuernberger, Roessl, Seidel, Zeilfelder, CAGD 22 (2005);
-Kalbe and Zeilfelder, paper 003 in the project library).
+ends of one edge of F: 24 tetrahedra in all [Nuernberger2005; Kalbe2008, sec. 3, Fig. 3].
 
 Fixed order and orientation
 ---------------------------
@@ -70,12 +69,27 @@ def _inner_faces():
 
 
 def type6_tetrahedra() -> np.ndarray:
-    """Vertices of the 24 tetrahedra, shape ``(24, 4, 3)``: ``[vQ, wF, u, u']`` in the documented order."""
+    """Vertices of the 24 tetrahedra, shape ``(24, 4, 3)``: ``[vQ, wF, u, u']`` in the documented order.
+
+    Examples
+    --------
+    >>> type6_tetrahedra()[0]  # the cube centre, the centre of face 0 (x = 0), an edge of that face
+    array([[0.5, 0.5, 0.5],
+           [0. , 0.5, 0.5],
+           [0. , 0. , 0. ],
+           [0. , 0. , 1. ]])
+    """
     return _tets().copy()
 
 
 def face_of_tet(t: int) -> tuple[int, int]:
-    """``(face f, edge k)`` of tetrahedron ``t = 4 f + k``."""
+    """``(face f, edge k)`` of tetrahedron ``t = 4 f + k``.
+
+    Examples
+    --------
+    >>> face_of_tet(5), face_of_tet(23)
+    ((1, 1), (5, 3))
+    """
     return divmod(int(t), 4)
 
 
@@ -90,7 +104,14 @@ def _bary_mats() -> np.ndarray:
 
 def barycentric_matrices() -> np.ndarray:
     """``(24, 4, 4)`` matrices ``B_t`` with ``lam = B_t @ (x, y, z, 1)``; column j < 3 of ``B_t`` is the
-    gradient of the barycentric coordinates w.r.t. local coordinate j."""
+    gradient of the barycentric coordinates w.r.t. local coordinate j.
+
+    Examples
+    --------
+    >>> B = barycentric_matrices()
+    >>> B.shape, B[0] @ [0.5, 0.5, 0.5, 1.0]  # the cube centre is vertex vQ of every tetrahedron
+    ((24, 4, 4), array([1., 0., 0., 0.]))
+    """
     return _bary_mats().copy()
 
 
@@ -100,7 +121,14 @@ def _bary(t, p):
 
 
 def barycentric(t, p) -> np.ndarray:
-    """Barycentric coordinates of local points ``p`` (..., 3) w.r.t. tetrahedra ``t`` (int array, broadcast)."""
+    """Barycentric coordinates of local points ``p`` (..., 3) w.r.t. tetrahedra ``t`` (int array, broadcast).
+
+    Examples
+    --------
+    >>> barycentric(0, [[0.0, 0.5, 0.5], [0.25, 0.375, 0.5]])  # the face centre wF; an interior point
+    array([[0.   , 1.   , 0.   , 0.   ],
+           [0.5  , 0.25 , 0.125, 0.125]])
+    """
     p = as_float64_array(p, "p (local cube coordinates)", shape_tail=(3,))
     t = np.asarray(t)
     if not np.issubdtype(t.dtype, np.integer) or (t.size and (t.min() < 0 or t.max() >= NUM_TETS)):
@@ -133,6 +161,19 @@ def locate(p, *, tol: float = 1e-12):
     lam : (..., 4) ndarray
         Barycentric coordinates w.r.t. ``[vQ, wF, u, u']`` of tetrahedron t; they sum to 1 and
         reproduce ``p``.
+
+    Examples
+    --------
+    >>> t, lam = locate([[0.5, 0.5, 0.5], [0.9, 0.5, 0.5], [0.1, 0.2, 0.3]])
+    >>> t
+    array([0, 4, 0])
+    >>> lam
+    array([[1. , 0. , 0. , 0. ],
+           [0.2, 0.8, 0. , 0. ],
+           [0.2, 0.2, 0.5, 0.1]])
+    >>> locate([1.5, 0.0, 0.0])
+    Traceback (most recent call last):
+    ValueError: p must lie in the unit cube [0, 1]^3 (local cube coordinates); the point at index () is [1.5, 0.0, 0.0].
     """
     p = as_float64_array(p, "p (local cube coordinates)", shape_tail=(3,))
     out = (p < -tol) | (p > 1 + tol)

@@ -79,6 +79,17 @@ def isosurface_program(model: Isosurface, style=None, *, newton_iterations: int 
     color_field : array-like (nz, ny, nx) or VolumeGrid, optional
         A second field on the same grid; the surface is coloured by its spline (same scheme) at the hit
         through the Style's colormap (``scalar_range`` defaults to the field's range).
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
+    >>> spec = isosurface_program(surface)  # 8 blocks of 8^3 cubes hold the 272 relevant cubes
+    >>> spec.points.shape, sorted(spec.textures), sorted(k for k, v in spec.defines.items() if v)
+    ((64, 3), ['sv_volume_data', 'sv_volume_mask'], ['SV_ROOTS_ANALYTIC', 'SV_VOLUME_BLOCKS'])
+    >>> spec = isosurface_program(surface, encoding="coefficients", proxy="cubes")  # one box per cube
+    >>> spec.points.shape, sorted(spec.textures)
+    ((2176, 3), ['sv_volume_coef'])
     """
     if not isinstance(model, Isosurface):
         raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")
@@ -154,6 +165,18 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     min-max octree), the proxy geometry, the ``sv_iso_shifted`` uniform and, for ``encoding="coefficients"``,
     the coefficient table. The data texture, the octree and the compiled program are kept (tested).
     Returns the new :class:`Relevant`.
+
+    Examples
+    --------
+    >>> from splinevis.plotting import Plotter
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> actor = pl.add_spline(surface)
+    >>> rel = set_isovalue(actor, 0.4)  # a smaller sphere: fewer cubes
+    >>> len(rel.cubes), actor.model.isovalue, round(actor.extra_uniforms["sv_iso_shifted"], 9)
+    (80, 0.4, -0.544754986)
+    >>> pl.close()
     """
     model = actor.model
     if not isinstance(model, Isosurface):
@@ -184,7 +207,18 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
 
 def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions`` (world), from
-    :func:`splinevis.gl.error_bounds.isosurface_depth_error_bound` in the model frame."""
+    :func:`splinevis.gl.error_bounds.isosurface_depth_error_bound` in the model frame.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
+    >>> o, d = np.array([[0.0, 0.0, 3.0]]), np.array([[0.0, 0.0, -1.0]])
+    >>> t = raycast_isosurface(surface, o, d).t
+    >>> bound = isosurface_depth_bound(surface, np.eye(4), o, d, t)  # identity camera: depth (z + 1) / 2
+    >>> bool(0.0 < bound[0] < 1e-5)
+    True
+    """
     sp = model.spline
     off = sp.origin
     lo, hi = sp.value_range
@@ -206,7 +240,26 @@ def _model_from(volume, isovalue, scheme="quadratic", **read_options) -> Isosurf
 def attach_culling(actor, plotter, *, culling: bool = True) -> None:
     """Hierarchical view-frustum culling of the proxies before every frame (``actor.culler``): blocks of
     2^theta cubes tested against the camera's planes by the octree over them
-    (:class:`splinevis.hierarchy.FrustumCuller`); images with and without are identical (tested)."""
+    (:class:`splinevis.hierarchy.FrustumCuller`); images with and without are identical (tested).
+
+    Examples
+    --------
+    >>> from splinevis.plotting import Plotter
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> actor = pl.add_spline(surface)
+    >>> attach_culling(actor, pl)
+    >>> pl.camera_position = [(0.0, 0.0, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)]
+    >>> _ = pl.screenshot()  # the first frame
+    >>> actor.culler.visible_units, len(actor.culler.units)  # all 8 blocks in view
+    (8, 8)
+    >>> pl.camera_position = [(0.0, 0.0, 3.0), (0.0, 0.0, 6.0), (0.0, 1.0, 0.0)]  # looking away
+    >>> pl.render()
+    >>> actor.culler.visible_units, actor.poly.GetNumberOfPolys()
+    (0, 0)
+    >>> pl.close()
+    """
     if not culling:
         return
     spec, model = actor.spec, actor.model

@@ -22,7 +22,16 @@ BLOCK_SIZE = 8
 
 
 def proxy_units(spline: VolumeSpline, rel: Relevant, proxy: str, block_size: int):
-    """The proxy boxes as (first cube (n, 3) int, cubes per axis (n, 3) int), in drawing order."""
+    """The proxy boxes as (first cube (n, 3) int, cubes per axis (n, 3) int), in drawing order.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12))
+    >>> first, size = proxy_units(spline, spline.relevant(0.7), "blocks", 8)  # 12 cubes: blocks of 8 and 4
+    >>> first[-1], size[-1], len(first)
+    (array([8, 8, 8]), array([4, 4, 4]), 8)
+    """
     if proxy == "blocks":
         B = block_size
         if not len(rel.cubes):
@@ -36,7 +45,16 @@ def proxy_units(spline: VolumeSpline, rel: Relevant, proxy: str, block_size: int
 
 
 def proxy_geometry(spline: VolumeSpline, rel: Relevant, encoding: str, proxy: str = "cubes", block_size: int = 8):
-    """Bounding geometry: points (model frame), triangles, flat attributes, varyings."""
+    """Bounding geometry: points (model frame), triangles, flat attributes, varyings.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12))
+    >>> points, triangles, attributes, varyings = proxy_geometry(spline, spline.relevant(0.7), "data", "blocks")
+    >>> points.shape, triangles.shape, sorted(attributes), sorted(varyings)  # 8 boxes, 12 triangles each
+    ((64, 3), (96, 3), ['sv_cube'], ['sv_local'])
+    """
     if proxy == "blocks":
         first, ext = proxy_units(spline, rel, proxy, block_size)
         n = len(first)
@@ -65,7 +83,14 @@ def proxy_geometry(spline: VolumeSpline, rel: Relevant, encoding: str, proxy: st
 
 def table_rows(rel: Relevant, encoding: str = "coefficients") -> np.ndarray:
     """Row of each relevant cube's data in the per-isovalue table: its first tetrahedron's row (coefficient
-    table) or the cube's own index (determining-set table)."""
+    table) or the cube's own index (determining-set table).
+
+    Examples
+    --------
+    >>> rel = Relevant(0.5, np.zeros((3, 3), np.int64), np.array([0b111, 0b1, 0b11]), 3, 0.0)
+    >>> table_rows(rel), table_rows(rel, "determining")  # 3, 1 and 2 relevant tetrahedra
+    (array([0, 3, 4]), array([0, 1, 2]))
+    """
     if encoding == "determining":
         return np.arange(len(rel.cubes), dtype=np.int64)
     counts = np.bitwise_count(rel.masks).astype(np.int64)

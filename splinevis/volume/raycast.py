@@ -45,6 +45,15 @@ def raycast_isosurface(model: Isosurface, origins, directions, tmin=0.0, *, meth
     RayHits
         ``t`` (NaN on a miss), hit points, and ``normals``: the world gradient of the spline at the hit
         (unnormalised).
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| = 0.7
+    >>> hits = raycast_isosurface(surface, [[0.0, 0.0, 3.0], [5.0, 5.0, 3.0]], [0.0, 0.0, -1.0])
+    >>> hits.hit, hits.points[0].round(3)  # the spline's sphere lies within 0.013 of the true one
+    (array([ True, False]), array([0.   , 0.   , 0.688]))
     """
     if not isinstance(model, Isosurface):
         raise TypeError(f"model must be an Isosurface, got {type(model).__name__}.")

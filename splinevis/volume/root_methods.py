@@ -2,9 +2,10 @@
 
 The volume ray caster (``glsl/programs/isosurface.glsl``) restricts a cubic trivariate spline to the
 ray's segment in a tetrahedron, subtracts the isovalue and needs the first root in [0, 1] of the
-resulting cubic BB polynomial (paper 003, sec. 5.3). Issue 4 offers a stable closed form
-(``sv_first_root_cubic``) and paper 003's Newton from three secure starts (``sv_first_root_newton3``);
-this module compares them -- and the library's bracketed Newton and paper 000's four-start Newton --
+resulting cubic BB polynomial [Kalbe2008, sec. 5.3]. The ray caster offers a stable closed form
+(``sv_first_root_cubic``) and the Newton iteration from three secure starts of [Kalbe2008, sec. 5.3]
+(``sv_first_root_newton3``); this module compares them -- and the library's bracketed Newton and the
+four-start Newton of [Reis2008, sec. V] --
 through their float32 twins on realistic inputs (:func:`sample_ray_cubics`), with
 :func:`splinevis.bb.roots.roots_reference` as the judge (:func:`compare_root_methods`).
 
@@ -66,6 +67,12 @@ def sample_ray_cubics(n: int, seed: int = 0, *, samples: int = 24, return_source
     Returns
     -------
     (n, 4) float64 ndarray (and the source indices)
+
+    Examples
+    --------
+    >>> cubics, source = sample_ray_cubics(6, seed=0, return_source=True)
+    >>> cubics.shape, np.bincount(source).tolist()  # half from each volume
+    ((6, 4), [3, 3])
     """
     from .model import VolumeSpline
 
@@ -135,6 +142,14 @@ def first_root_tolerance(c, r):
     ``|dx| <= 2 eps_f / (|f'| + sqrt(f'^2 + 2 |f''| eps_f))`` -- the linear bound ``eps_f / |f'|`` for a
     simple root, ``sqrt(2 eps_f / |f''|)`` for a double (tangent) root -- and the float32 argument itself
     is only resolved to half an ulp, ``<= eps32 |r| / 2``; ``delta = that + eps32 |r|``.
+
+    Examples
+    --------
+    A simple root of ``(t - 1/4)(t - 3/4)`` and the double root of ``(t - 1/2)^2``, in units of eps32:
+
+    >>> c = np.array([[3 / 16, -7 / 48, -7 / 48, 3 / 16], [1 / 4, -1 / 12, -1 / 12, 1 / 4]])
+    >>> (first_root_tolerance(c, np.array([0.25, 0.5])) / 2.0 ** -23).round(1)
+    array([   7.6, 4857.8])
     """
     from ..selftest import EVAL_BOUND
 
@@ -184,9 +199,9 @@ def compare_root_methods(cubics, iterations=(3, 5, 8), *, ref=None, masks: bool 
     the GPU sees them, and the reference solves that same float32 polynomial in float64):
 
     * ``"analytic cubic"`` -- :func:`splinevis.bb.roots.first_root_cubic` (closed form + 1 polish step);
-    * ``"newton3 paper I=N"`` -- :func:`splinevis.bb.roots.newton_three_starts` (paper 003);
+    * ``"newton3 paper I=N"`` -- :func:`splinevis.bb.roots.newton_three_starts` ([Kalbe2008, sec. 5.3]);
     * ``"bracketed I=N"`` -- :func:`splinevis.bb.roots.first_root_bracketed` (the library default);
-    * ``"newton4 I=N"`` -- :func:`splinevis.bb.roots.newton_secure` (paper 000's four starts);
+    * ``"newton4 I=N"`` -- :func:`splinevis.bb.roots.newton_secure` (the four starts of [Reis2008, sec. V]);
 
     for every ``N`` in ``iterations``.
 
@@ -213,6 +228,12 @@ def compare_root_methods(cubics, iterations=(3, 5, 8), *, ref=None, masks: bool 
     -------
     dict
         ``{method: {category: count}}`` plus ``"_n"`` and ``"_with_root"`` (cubics whose reference has a root).
+
+    Examples
+    --------
+    >>> table = compare_root_methods([[3 / 16, -7 / 48, -7 / 48, 3 / 16], [1.0, 2.0, 2.0, 1.0]], iterations=(5,))
+    >>> table["_n"], table["_with_root"], table["analytic cubic"]["correct"], table["analytic cubic"]["no_root_agreed"]
+    (2, 1, 1, 1)
     """
     c = np.asarray(cubics, dtype=np.float64)
     if c.ndim != 2 or c.shape[1] != 4:
@@ -237,7 +258,14 @@ def compare_root_methods(cubics, iterations=(3, 5, 8), *, ref=None, masks: bool 
 
 
 def format_table(table: dict) -> str:
-    """The counts of :func:`compare_root_methods` as a fixed-width text table."""
+    """The counts of :func:`compare_root_methods` as a fixed-width text table.
+
+    Examples
+    --------
+    >>> table = compare_root_methods([[3 / 16, -7 / 48, -7 / 48, 3 / 16], [1.0, 2.0, 2.0, 1.0]], iterations=(5,))
+    >>> print(format_table(table).splitlines()[2])
+    analytic cubic             1          0          0          0          0          0          1          0
+    """
     cols = list(CATEGORIES) + ["spurious_near_root"]
     names = [k for k in table if not k.startswith("_")]
     w = max(len(k) for k in names)

@@ -1,5 +1,5 @@
-"""Quadratic super spline of volume data on the type-6 partition (Roessl et al. 2004; Nuernberger et
-al., CAGD 22 (2005); used on the GPU by Kalbe and Zeilfelder, paper 003), and the interface shared with
+"""Quadratic super spline of volume data on the type-6 partition [Roessl2004; Nuernberger2005] (used on
+the GPU in [Kalbe2008, sec. 4-5]), and the interface shared with
 the cubic C1 scheme (:mod:`splinevis.volume.cubic`) in the format the GPU program reads: ``STENCIL``,
 :func:`pad_volume`, :func:`tet_weights`, :func:`spline_coefficients`, :func:`cube_coefficients`,
 :func:`evaluate`, :func:`evaluate_volume`. See docs/volume-schemes.md. The stencil and the padding are
@@ -80,14 +80,24 @@ def _domain():
 
 def domain_points():
     """``(points (65, 3), tet_map (24, 10))``: the distinct domain points (local coordinates) and, for
-    every tetrahedron and BB coefficient, the index of its domain point."""
+    every tetrahedron and BB coefficient, the index of its domain point.
+
+    >>> points, tet_map = domain_points()
+    >>> points.shape, tet_map.shape, points[tet_map[0, 0]]  # coefficient (2, 0, 0, 0) sits at vQ
+    ((65, 3), (24, 10), array([0.5, 0.5, 0.5]))
+    """
     pts, tmap, _ = _domain()
     return pts.copy(), tmap.copy()
 
 
 def edge_points() -> np.ndarray:
     """Indices (into :func:`domain_points`) of the 20 determining points on the cube's edges, in
-    increasing order."""
+    increasing order.
+
+    >>> points = domain_points()[0][edge_points()]
+    >>> len(points), int(((points == 0) | (points == 1)).sum(axis=1).min())  # 8 vertices, 12 edge midpoints
+    (20, 2)
+    """
     pts = _domain()[0]
     on = ((pts == 0) | (pts == 1)).sum(axis=1) >= 2
     return np.flatnonzero(on)
@@ -107,7 +117,12 @@ def _idx(x):
 def inner_face_conditions():
     """C1 conditions across the 36 inner faces of the split: ``(A (108, 65), pairs)`` with ``A @ c = 0``
     for the 65 domain-point coefficients ``c`` of a spline that is C1 inside the cube; row ``3 m + r``
-    belongs to the face shared by tetrahedra ``pairs[m]``."""
+    belongs to the face shared by tetrahedra ``pairs[m]``.
+
+    >>> A, pairs = inner_face_conditions()
+    >>> A.shape, len(pairs), pairs[0]
+    ((108, 65), 36, (0, 1))
+    """
     A, pairs = inner_face_rows(2)
     return A.copy(), list(pairs)
 
@@ -274,6 +289,12 @@ def derive_weights() -> dict:
         ``"face_residual"``: residual of the face (criss-cross) C1 solve;
         ``"hard_residual"``: residual of the exactly imposed conditions (cube-face C1, linear
         reproduction, the inner C1 conditions flagged exact).
+
+    Examples
+    --------
+    >>> d = derive_weights()
+    >>> d["W"].shape, len(d["exact_faces"]), bool(d["hard_residual"] < 1e-12)  # C1 across 24 of 36 faces
+    ((65, 27), 24, True)
     """
     W, exact, pairs, face_res, hard_res = _weights()
     ex_faces = [pairs[m] for m in range(len(pairs)) if exact[3 * m:3 * m + 3].all()]
@@ -330,6 +351,12 @@ def tet_weights(scheme: str) -> np.ndarray:
         :func:`pad_volume` (index ``(x, y, z)`` reads ``padded[z + 1, y + 1, x + 1]``). The weights are
         multiples of 1/16 (quadratic, exact in float64) resp. 1/192 (cubic, rounded to float64),
         nonnegative, and sum to 1 per coefficient.
+
+    Examples
+    --------
+    >>> W = tet_weights("quadratic")
+    >>> W.shape, bool((16 * W == np.round(16 * W)).all()), float(W.sum(axis=-1).min()), float(W.min())
+    ((24, 10, 27), True, 1.0, 0.0)
     """
     return _tet_weights(_check_scheme(scheme)).copy()
 
@@ -348,6 +375,11 @@ def spline_coefficients(volume, scheme: str) -> np.ndarray:
     (nz, ny, nx, 24, m) float64 ndarray, m = 10 or 20
         Needs ``nz * ny * nx * 24 * m * 8`` bytes (2.6 GB for a cubic 256^3 volume): for big volumes use
         :func:`cube_coefficients` on the cubes you need.
+
+    Examples
+    --------
+    >>> spline_coefficients(np.zeros((4, 5, 6)), "cubic").shape
+    (4, 5, 6, 24, 20)
     """
     scheme = _check_scheme(scheme)
     vol = _check_volume(volume)
@@ -382,7 +414,15 @@ def cube_coefficients(volume, cubes, scheme: str) -> np.ndarray:
 
     Returns
     -------
-    (n, 24, m) float64 ndarray, equal to ``spline_coefficients(volume, scheme)[k, j, i]`` row by row.
+    (n, 24, m) float64 ndarray, equal to ``spline_coefficients(volume, scheme)[k, j, i]`` row by row (up to
+    the rounding of a different summation order).
+
+    Examples
+    --------
+    >>> volume = np.random.default_rng(0).random((4, 4, 4))
+    >>> c = cube_coefficients(volume, [[1, 2, 0]], "quadratic")
+    >>> c.shape, float(np.abs(c[0] - spline_coefficients(volume, "quadratic")[0, 2, 1]).max()) < 1e-15
+    ((1, 24, 10), True)
     """
     scheme = _check_scheme(scheme)
     vol = _check_volume(volume)
@@ -446,6 +486,13 @@ def evaluate(coef, points, *, gradient: bool = False, tol: float = 1e-9):
     Returns
     -------
     values (...), or (values, gradients (..., 3)).
+
+    Examples
+    --------
+    >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+    >>> coef = spline_coefficients(x + 2 * y + 3 * z, "quadratic")
+    >>> evaluate(coef, [[1.25, 2.0, 0.5]], gradient=True)  # linear data are reproduced
+    (array([6.75]), array([[1., 2., 3.]]))
     """
     c = _check_coef(coef)
     p = as_float64_array(points, "points", shape_tail=(3,))
@@ -458,7 +505,14 @@ def evaluate(coef, points, *, gradient: bool = False, tol: float = 1e-9):
 def evaluate_volume(volume, points, scheme: str, *, gradient: bool = False, tol: float = 1e-9):
     """Evaluate the spline of ``volume`` at ``points`` building only the cubes that contain them
     (memory O(points), any volume size); same result as ``evaluate(spline_coefficients(volume, scheme),
-    points)``."""
+    points)``.
+
+    Examples
+    --------
+    >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+    >>> evaluate_volume(x ** 2, [[1.3, 1.0, 1.0]], "cubic").round(12)  # x^2 + 1/4: the schemes' constant shift
+    array([1.94])
+    """
     scheme = _check_scheme(scheme)
     vol = _check_volume(volume)
     p = as_float64_array(points, "points", shape_tail=(3,))
@@ -485,5 +539,11 @@ def quadratic_super_spline(volume) -> np.ndarray:
     (nz, ny, nx, 24, 10) float64 ndarray
         Cube ``[k, j, i]`` is centred at the data point (i, j, k); patch t is tetrahedron t of
         :func:`splinevis.volume.partition.type6_tetrahedra`, coefficients in ``multi_indices(2, 3)`` order.
+
+    Examples
+    --------
+    >>> c = quadratic_super_spline(np.full((3, 3, 3), 7.0))
+    >>> c.shape, float(c.min()), float(c.max())  # constants are reproduced
+    ((3, 3, 3, 24, 10), 7.0, 7.0)
     """
     return spline_coefficients(volume, "quadratic")

@@ -65,7 +65,16 @@ def _pad(vol):
 def pad_volume(volume) -> np.ndarray:
     """The volume with one layer of linear extrapolation on every side (``f[-1] = 2 f[0] - f[1]``, axis by
     axis, so edges and corners too): shape ``(nz + 2, ny + 2, nx + 2)``; ``padded[k + 1, j + 1, i + 1] =
-    volume[k, j, i]``. Linear data stay linear. Every axis needs >= 2 samples."""
+    volume[k, j, i]``. Linear data stay linear. Every axis needs >= 2 samples.
+
+    Examples
+    --------
+    >>> padded = pad_volume(np.arange(8.0).reshape(2, 2, 2))  # f = x + 2 y + 4 z
+    >>> padded.shape, padded[1, 1]  # the row y = 0, z = 0, extended to x = -1 and x = 2
+    ((4, 4, 4), array([-1.,  0.,  1.,  2.]))
+    >>> float(padded[0, 0, 0])  # the corner (-1, -1, -1): -1 - 2 - 4
+    -7.0
+    """
     return _pad(_check_volume(volume))
 
 

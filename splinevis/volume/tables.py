@@ -24,13 +24,32 @@ __all__ = ["data_texture", "coefficient_table", "determining_table", "mask_textu
 
 def data_texture(spline: VolumeSpline) -> np.ndarray:
     """The padded volume minus :func:`~splinevis.volume.isosurface.value_reference`, x fastest, as a table
-    texture (:func:`splinevis.gl.proxies.pack_rgba32f`)."""
+    texture (:func:`splinevis.gl.proxies.pack_rgba32f`).
+
+    Examples
+    --------
+    >>> spline = VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0)  # 1000 + x + 3 y + 9 z
+    >>> table = data_texture(spline)  # 5^3 padded values minus 1013, four per texel
+    >>> table.shape, table.dtype, table[0, 0]  # from the padded corner (-1, -1, -1): 987 - 1013
+    ((1, 8192, 4), dtype('float32'), array([-26., -25., -24., -23.], dtype=float32))
+    """
     return pack_rgba32f(spline.padded, value_reference(spline), name="volume data texture")
 
 
 def coefficient_table(spline: VolumeSpline, relevant: Relevant) -> np.ndarray:
     """Texture of the coefficients of every relevant tetrahedron (minus the reference value), in cube order
-    then tetrahedron order; cube n's first row is ``table_rows(relevant)[n]``."""
+    then tetrahedron order; cube n's first row is ``table_rows(relevant)[n]``.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12))
+    >>> rel = spline.relevant(0.7)
+    >>> rows = coefficient_table(spline, rel).reshape(-1)[: 10 * rel.num_tets].reshape(-1, 10)
+    >>> first = spline.cube_coefficients(rel.cubes[:1])[0][(rel.masks[0] >> np.arange(24)) & 1 == 1]
+    >>> bool(np.allclose(rows[: len(first)], first - value_reference(spline), atol=1e-6))  # cube 0's tetrahedra
+    True
+    """
     out = np.empty((relevant.num_tets, spline.ncoef), dtype=np.float64)
     ref = value_reference(spline)
     chunk, pos = 16384, 0
@@ -47,7 +66,17 @@ def memory_report(spline: VolumeSpline, relevant: Relevant, block_size: int = BL
     """Bytes of each part for one isovalue: bounding geometry as VTK uploads it (float32 points, the flat
     and interpolated attributes, int indices) for the default block proxies (plus their per-cube info
     texture) and for cube proxies, the data texture, the coefficient table, every coefficient, the paper's
-    determining sets (20 / 56 floats per cube), and the octree."""
+    determining sets (20 / 56 floats per cube), and the octree.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12))
+    >>> rel = spline.relevant(0.7)
+    >>> report = memory_report(spline, rel)
+    >>> report["relevant_cubes"], report["proxy_blocks"], report["coefficient_table_bytes"]
+    (272, 8, 128640)
+    """
     n = len(relevant.cubes)
     m = spline.ncoef
     per_box = 8 * (3 * 4 + 4 * 4 + 3 * 4) + 12 * 3 * 4  # points + sv_cube + sv_local; 12 triangles
@@ -68,7 +97,16 @@ def memory_report(spline: VolumeSpline, relevant: Relevant, block_size: int = BL
 
 def determining_table(spline: VolumeSpline, rel: Relevant) -> np.ndarray:
     """The 56 determining coefficients of every relevant cube (cubic scheme, [Kalbe2008, sec. 5.1, Fig. 4]
-    masks), minus the reference value, 56 floats per cube, as a table texture."""
+    masks), minus the reference value, 56 floats per cube, as a table texture.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12), "cubic")
+    >>> table = determining_table(spline, spline.relevant(0.7))
+    >>> table.shape, table.dtype  # 272 cubes x 56 coefficients fit one row of 8192 texels
+    ((1, 8192, 4), dtype('float32'))
+    """
     from .cubic import determining_map
 
     _, K = determining_map()
@@ -84,7 +122,17 @@ def mask_texture(spline: VolumeSpline, rel: Relevant, block_size: int = BLOCK_SI
     """Cube-info table of the block proxies: for every block drawn (in :func:`proxy_units` order) one texel per
     cube of the block, ``block_id * B^3 + (a_z B + a_y) B + a_x``: the relevant-tetrahedron mask (exact:
     < 2^24), the cube's first coefficient-table row as two 12-bit halves, 0 = not relevant. Only blocks
-    holding relevant cubes are stored."""
+    holding relevant cubes are stored.
+
+    Examples
+    --------
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> spline = VolumeSpline(sphere_grid(12))
+    >>> rel = spline.relevant(0.7)
+    >>> info = mask_texture(spline, rel)  # 8 blocks x 8^3 cubes, one texel each
+    >>> int((info[..., 0] > 0).sum()) == len(rel.cubes)
+    True
+    """
     B = block_size
     first, _ = proxy_units(spline, rel, "blocks", B)
     info = np.zeros((len(first) * B ** 3, 4), dtype=np.float32)

@@ -1,5 +1,5 @@
 """The trilinear interpolant of volume data: the baseline of the spline schemes (what VTK's ray caster and
-most GPU volume renderers use; paper 003, Sect. 1 and Fig. 8, "continuous, piecewise cubics obtained from
+most GPU volume renderers use; [Kalbe2008, sec. 1, Fig. 8]: "continuous, piecewise cubics obtained from
 successive univariate linear interpolation").
 
 Conventions as in :mod:`splinevis.volume.schemes`: ``volume[k, j, i]`` is the value at the index-space

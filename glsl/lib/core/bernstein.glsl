@@ -2,13 +2,14 @@
 //
 // Coefficients live in a fixed-size array float c[5]; only c[0..n] are read.  Coefficient k multiplies
 //     B^n_k(t) = C(n, k) (1 - t)^(n - k) t^k
-// (the ordering of splinevis.bb.simplex.multi_indices(n, 1)).  Farin, "Curves and Surfaces for CAGD",
-// ch. 3 (de Casteljau) and ch. 5 (derivatives).  The float64 twin is splinevis.bb.roots._eval_deriv,
+// (the ordering of splinevis.bb.simplex.multi_indices(n, 1)).  [Farin2002, ch. 3] (de Casteljau) and
+// [Farin2002, ch. 5] (derivatives).  The float64 twin is splinevis.bb.roots._eval_deriv,
 // which performs the same operations in the same order.
 //
 // Rounding (float32, unit roundoff u = 2^-24): every level computes s*a + t*b with s = fl(1 - t), i.e.
-// at most 3 roundings per level, so |fl(f) - f| <= gamma_{3n} * sum_k |c_k| B^n_k(t),
-// gamma_m = m u / (1 - m u).  A fused multiply-add only removes roundings.
+// at most 3 roundings per level, so |fl(f) - f| <= gamma_{3n} * sum_k |c_k| B^n_k(t)
+// [MainarPena1999], gamma_m = m u / (1 - m u) [Higham2002, sec. 3.4].  A fused multiply-add only removes
+// roundings.
 
 // de Casteljau down to the last two intermediate values (n - 1 levels, n >= 1):
 //     b0 = sum_k c_k B^{n-1}_k(t),   b1 = sum_k c_{k+1} B^{n-1}_k(t).
@@ -26,8 +27,8 @@ void sv_bernstein_last2(float c[5], int n, float t, out float b0, out float b1) 
     b1 = b[1];
 }
 
-// Value f(t) and derivative f'(t) = n (b1 - b0) (Farin eq. 5.23: the last de Casteljau level gives the
-// tangent).  n = 0: f = c[0], f' = 0.
+// Value f(t) and derivative f'(t) = n (b1 - b0) ([Farin2002, eq. 5.23]: the last de Casteljau level gives
+// the tangent).  n = 0: f = c[0], f' = 0.
 void sv_bernstein_eval_deriv(float c[5], int n, float t, out float f, out float fp) {
     if (n <= 0) {
         f = c[0];

@@ -1,8 +1,7 @@
 // First root in [0, 1] of a univariate BB polynomial of degree n <= 4, two methods:
 //
-// * sv_first_root_newton4 -- paper 000's method (Kalbe, Zeilfelder et al., "High-quality rendering of
-//   varying isosurfaces with cubic trivariate C1-continuous splines" / the quartic ray-patch intersection
-//   of paper 000, sec. VI, the pseudo-code "x0 = (0, w0, w1, 1); for (i = 0; i < 6; i++)
+// * sv_first_root_newton4 -- the Newton iteration of the quartic ray-patch intersection of
+//   [Reis2008, sec. V] (its pseudo-code "x0 = (0, w0, w1, 1); for (i = 0; i < 6; i++)
 //   x_{i+1} = x_i - F(x_i)/F'(x_i)"): Newton from the secure starting points, residual acceptance.
 //   Measured to return a LATER root than the first one in ~17% of well-conditioned quartic cases with
 //   6 steps (Newton from 0 converges to the first root only linearly while far from it), to miss double
@@ -62,8 +61,9 @@ void sv_inflection_points(float c[5], int n, out float w0, out float w1) {
     }
 }
 
-// Newton from the four starts x with `iterations` (1..8) steps and the residual acceptance of paper 000:
-// the smallest accepted x in [0, 1], -1.0 if none (shared by the paper's 4-start and 3-start variants).
+// Newton from the four starts x with `iterations` (1..8) steps and the residual acceptance of
+// sv_first_root_newton4: the smallest accepted x in [0, 1], -1.0 if none (shared by the 4-start variant of
+// [Reis2008, sec. V] and the 3-start variant of [Kalbe2008, sec. 5.3]).
 float sv_newton_from_starts(float c[5], int n, vec4 x, int iterations) {
     vec4 f;
     vec4 fp;
@@ -92,7 +92,7 @@ float sv_newton_from_starts(float c[5], int n, vec4 x, int iterations) {
     return (best <= 1.0) ? best : -1.0;
 }
 
-// Paper 000's method.  Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after
+// The method of [Reis2008, sec. V].  Smallest root in [0, 1] of f(t) = sum_{k<=n} c_k B^n_k(t), n in 0..4, after
 // `iterations` (1..8) Newton steps from x = (0, w0, w1, 1).  Returns -1.0 when no candidate passes the residual test
 // |f(x)| <= K_n eps32 sum_k |c_k| B^n_k(x) (the Python twin returns NaN there).  A start whose
 // derivative is 0, or whose step is not finite, keeps its x.  Nothing is clamped: iterates leaving
@@ -265,8 +265,8 @@ float sv_first_root_bracketed(float c[5], int n, int iterations) {
     return (abs(f[3]) <= tol[3]) ? 1.0 : -1.0;
 }
 
-// The method the ray-cast programs use: bracketed Newton on convex pieces, or paper 000's 4-start
-// Newton iteration when SV_ROOTS_PAPER is defined (for comparison).
+// The method the ray-cast programs use: bracketed Newton on convex pieces, or the 4-start Newton
+// iteration of [Reis2008, sec. V] when SV_ROOTS_PAPER is defined (for comparison).
 float sv_first_root(float c[5], int n, int iterations) {
 #ifdef SV_ROOTS_PAPER
     return sv_first_root_newton4(c, n, iterations);
@@ -276,7 +276,7 @@ float sv_first_root(float c[5], int n, int iterations) {
 }
 
 // ------------------------------------------------------------------------------------------------------
-// Closed form for quadratics (paper 003, sec. 5.3: "well known formulae [HE95] ... in an analytical and
+// Closed form for quadratics ([Kalbe2008, sec. 5.3]: "well known formulae [HE95] ... in an analytical and
 // stable way").  f(t) = c0 (1-t)^2 + 2 c1 (1-t) t + c2 t^2 = A t^2 + B t + C with A = c0 - 2 c1 + c2,
 // B = 2 (c1 - c0), C = c0.  Roots by q = -(B + sign(B) sqrt(B^2 - 4 A C)) / 2, t = q / A and C / q (no
 // cancellation between B and the square root).  A negative discriminant within rounding of a touching
@@ -312,7 +312,7 @@ float sv_first_root_quadratic(float c[5]) {
 }
 
 // ------------------------------------------------------------------------------------------------------
-// Stable closed form for cubics (issue 4; paper 003, sec. 5.3: "well known formulae [HE95] ... in an
+// Stable closed form for cubics ([Kalbe2008, sec. 5.3]: "well known formulae [HE95] ... in an
 // analytical and stable way").  The float64/float32 twin is splinevis.bb.roots.first_root_cubic.
 //
 // Homogeneous form.  With x = t, w = 1 - t the cubic BB polynomial is
@@ -324,7 +324,7 @@ float sv_first_root_quadratic(float c[5]) {
 // "degenerate leading coefficient" needs no fallback to sv_first_root_quadratic (the quadratic's roots
 // come out of the same formulas; measured in tests/test_roots_cubic.py).
 // Hessian d1 = AC - B^2, d2 = AD - BC, d3 = BD - C^2; discriminant disc = 4 d1 d3 - d2^2 (> 0: three real
-// roots, < 0: one).  Two depressed forms (Blinn, "How to solve a cubic equation", IEEE CG&A 2006/07):
+// roots, < 0: one).  Two depressed forms ([Blinn2007] and parts 1-4 of the same column):
 //   A-form: x = (y - B) / A with y^3 + 3 d1 y + (A d2 - 2 B d1) = 0   accurate for |x / w| large (t ~ 1),
 //   D-form: w = (z - C) / D with z^3 + 3 d3 z + (D d2 - 2 C d3) = 0   accurate for |x / w| small (t ~ 0);
 // their depressed discriminants are 4 (-d1)^3 - Q_A^2 = A^2 disc and 4 (-d3)^3 - Q_D^2 = D^2 disc, so
@@ -458,7 +458,7 @@ float sv_first_root_cubic(float c[5]) {
 }
 
 // ------------------------------------------------------------------------------------------------------
-// Paper 003's method (sec. 5.3): Newton's method from the three starting values 0, the inflection point
+// The method of [Kalbe2008, sec. 5.3]: Newton's method from the three starting values 0, the inflection point
 // w of the cubic (the root of f'', w = 1/2 if there is none in (0, 1)) and 1, with a fixed number of
 // iterations (the paper: I = 5).  Same residual acceptance, no clamping and the same guards as
 // sv_first_root_newton4 (the paper gives no acceptance rule; a returned iterate must pass

@@ -2,8 +2,8 @@
 //
 // 15 coefficients b[ijk], i+j+k = 4, ordered as splinevis.bb.simplex.multi_indices(4, 2): i descending,
 // then j descending ((4,0,0), (3,1,0), (3,0,1), (2,2,0), ...).  A point is given by barycentric
-// coordinates l (l.x + l.y + l.z = 1).  Farin, "Curves and Surfaces for CAGD", ch. 17-18: after r
-// de Casteljau steps at l the degree-(4-r) coefficients give the derivatives
+// coordinates l (l.x + l.y + l.z = 1).  After r de Casteljau steps at l the degree-(4-r) coefficients
+// give the derivatives [Farin2002, ch. 17.5; LaiSchumaker2007, Thm. 2.15]
 //     D_u f = 4 * sum_i u_i a[e_i]                     (r = 3, a linear in the step's point)
 //     D_u D_v f = 12 * sum_{i,j} u_i v_j d[e_i + e_j]   (r = 2)
 // for directions u, v with components summing to zero.

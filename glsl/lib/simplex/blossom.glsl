@@ -4,7 +4,7 @@
 // The 15 coefficients b[q] are ordered as splinevis.bb.simplex.multi_indices(4, 2) (lexicographic
 // descending: (4,0,0), (3,1,0), (3,0,1), (2,2,0), (2,1,1), (2,0,2), (1,3,0), ...).  Along the segment
 // from barycentric point l0 to l1 the patch is the univariate quartic with BB coefficients
-//     c_k = blossom(l0^{4-k}, l1^k),   k = 0..4              (paper 000, eq. (5); Farin ch. 17.4)
+//     c_k = blossom(l0^{4-k}, l1^k),   k = 0..4              [Reis2008, eq. (5); Farin2002, ch. 17.4]
 // The blossom is evaluated by de Casteljau steps using l0 for the first 4 - k levels and l1 for the
 // remaining k.  The float64 twin is splinevis.bb.simplex.restrict_to_segment (same step order, same
 // summation order l.x*a + l.y*b + l.z*c).  Rounding: each level rounds each term at most 3 times

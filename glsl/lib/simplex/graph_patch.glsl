@@ -1,11 +1,11 @@
-// A ray against one quartic BB triangle patch of a graph surface z = f(x, y) (paper 000, sec. VI): the
+// A ray against one quartic BB triangle patch of a graph surface z = f(x, y) ([Reis2008, sec. V]): the
 // step shared by the analytic patch and every terrain triangle.
 //
 // 1. Clip t in [ta, tb] to the triangle (barycentric coordinates >= -margin; the ray's barycentric
 //    coordinates are affine: lam_o + t lam_d) and to the slab between the smallest and largest
 //    coefficient (convex hull property), widened by ~16 ulps of the heights involved so that a flat
 //    patch does not collapse it to a point and leave hit or miss to rounding.
-// 2. Restrict f to the segment by blossoming (eqs. (6)-(7)) and subtract the ray's height, a linear
+// 2. Restrict f to the segment by blossoming ([Reis2008, eqs. (6)-(7)]) and subtract the ray's height, a linear
 //    function written as a quartic: c_k -= z0 + (k/4)(z1 - z0).
 // 3. No sign change among the c_k: no root (convex hull), skip the root finder; else the first root.
 // The float64 twin is splinevis.bb.ray.graph_patch_first_hit.

@@ -3,14 +3,15 @@
 Three methods:
 
 * :func:`first_root_bracketed` -- the default GPU method (``sv_first_root_bracketed``, used by
-  ``sv_first_root`` in ``glsl/lib/roots.glsl``), a line-by-line twin: bracketed Newton on the convex
+  ``sv_first_root`` in ``glsl/lib/core/roots.glsl``), a line-by-line twin: bracketed Newton on the convex
   pieces between the inflection points, with a fixed iteration budget (:mod:`.bracketed`).
-* :func:`newton_secure` -- [Reis2008]'s GPU method (``sv_first_root_newton4``; ``sv_first_root`` with
-  ``SV_ROOTS_PAPER_NEWTON`` defined), a line-by-line twin: Newton iteration from the "secure" starting
-  points ``(0, w0, w1, 1)`` (end points and inflection points), accepting the smallest iterate in [0, 1]
-  that passes a residual test whose constant is derived from the float32 rounding bound of de
-  Casteljau's algorithm ([Reis2008], sec. VI). It often returns a later root than the first one
-  (:mod:`.newton`, with [Kalbe2008]'s three-start variant for cubics, :func:`newton_three_starts`).
+* :func:`newton_secure` -- the GPU method of [Reis2008, sec. V] (``sv_first_root_newton4``;
+  ``sv_first_root`` with ``SV_ROOTS_PAPER`` defined), a line-by-line twin: Newton iteration from the
+  "secure" starting points ``(0, w0, w1, 1)`` (end points and inflection points), accepting the smallest
+  iterate in [0, 1] that passes a residual test whose constant splinevis derives from the float32
+  rounding bound of de Casteljau's algorithm [MainarPena1999; Higham2002, sec. 3.4]. It often returns a
+  later root than the first one (:mod:`.newton`, with the three-start variant of [Kalbe2008, sec. 5.3] for
+  cubics, :func:`newton_three_starts`).
 * :func:`roots_reference` -- a robust float64 reference that reports every root in [0, 1] (companion
   matrix eigenvalues, a sign-change scan with bisection, Newton polishing, merging of duplicates)
   (:mod:`.reference`).

@@ -16,7 +16,7 @@ __all__ = ["eval_deriv", "inflection_points"]
 
 
 def _eval_deriv(c, x, dtype):
-    """mirrors glsl/lib/bernstein.glsl sv_bernstein_eval_deriv(4): value and derivative at x.
+    """mirrors glsl/lib/core/bernstein.glsl sv_bernstein_eval_deriv(4): value and derivative at x.
     c: (..., n+1), x: broadcasting against c[..., 0] (possibly with an extra trailing axis handled by caller)."""
     n = c.shape[-1] - 1
     one = dtype(1.0)
@@ -44,12 +44,19 @@ def eval_deriv(c, t, *, dtype=np.float64):
         Parameters, broadcasting against ``c.shape[:-1]``.
     dtype : {numpy.float64, numpy.float32}
         Arithmetic precision. float32 reproduces ``sv_bernstein_eval_deriv`` of
-        ``glsl/lib/bernstein.glsl`` operation by operation (up to fused multiply-adds on the GPU).
+        ``glsl/lib/core/bernstein.glsl`` operation by operation (up to fused multiply-adds on the GPU).
 
     Returns
     -------
     f, fp : ndarray
         ``f(t)`` after n de Casteljau levels and ``f'(t) = n (b1 - b0)``.
+
+    Examples
+    --------
+    ``(t - 1/4)(t - 3/4)`` in BB form:
+
+    >>> eval_deriv([3 / 16, -5 / 16, 3 / 16], [0.25, 0.5, 0.75])
+    (array([ 0.    , -0.0625,  0.    ]), array([-0.5,  0. ,  0.5]))
     """
     c = _check_univariate(c)
     t = as_float64_array(t, "t")
@@ -59,7 +66,7 @@ def eval_deriv(c, t, *, dtype=np.float64):
 
 
 def _inflection_points(c, dtype):
-    """mirrors glsl/lib/roots.glsl sv_inflection_points."""
+    """mirrors glsl/lib/core/roots.glsl sv_inflection_points."""
     n = c.shape[-1] - 1
     shape = c.shape[:-1]
     w0 = np.full(shape, -1.0, dtype=dtype)
@@ -100,6 +107,13 @@ def inflection_points(c, *, dtype=np.float64):
     Returns
     -------
     w0, w1 : ndarray, shape ``c.shape[:-1]``
+
+    Examples
+    --------
+    >>> inflection_points([1.0, -1.0, 1.0, -1.0])  # a cubic: one inflection point
+    (array(0.5), array(-1.))
+    >>> inflection_points([0.0, 0.0, 1.0])  # a quadratic has none
+    (array(-1.), array(-1.))
     """
     c = _check_univariate(c)
     dtype = _check_dtype(dtype)

@@ -15,7 +15,7 @@ MAX_BRACKET_ITERATIONS = 16
 
 
 def _fourier_step(lo, hi, glo, ghi, dlo, dhi, sigma):
-    """mirrors glsl/lib/roots.glsl sv_bracket_newton: Newton step from the Fourier end of [lo, hi]."""
+    """mirrors glsl/lib/core/roots.glsl sv_bracket_newton: Newton step from the Fourier end of [lo, hi]."""
     # bool from_lo = (sigma != 0.0) ? ((glo < 0.0) == (sigma < 0.0)) : (abs(glo) <= abs(ghi));
     from_lo = np.where(sigma != 0.0, (glo < 0.0) == (sigma < 0.0), np.abs(glo) <= np.abs(ghi))
     x = np.where(from_lo, lo, hi)
@@ -25,7 +25,7 @@ def _fourier_step(lo, hi, glo, ghi, dlo, dhi, sigma):
 
 
 def _bracket_newton(g, lo, hi, glo, ghi, dlo, dhi, sigma, iterations, dtype):
-    """mirrors glsl/lib/roots.glsl sv_bracket_newton (rows independent). g: (M, m+1); the rest (M,)."""
+    """mirrors glsl/lib/core/roots.glsl sv_bracket_newton (rows independent). g: (M, m+1); the rest (M,)."""
     quarter, half, three = dtype(0.25), dtype(0.5), dtype(0.75)
     g3 = g[:, None, :]
     for _ in range(iterations):                                    # for (it < 16) if (it < iterations)
@@ -52,8 +52,8 @@ def _bracket_newton(g, lo, hi, glo, ghi, dlo, dhi, sigma, iterations, dtype):
 def first_root_bracketed(c, iterations: int = 8, *, dtype=np.float64):
     """First root in [0, 1] by bracketed Newton on convex pieces (the default GPU method).
 
-    Mirrors ``sv_first_root_bracketed`` in ``glsl/lib/roots.glsl`` line by line (``sv_first_root``
-    dispatches to it unless ``SV_ROOTS_PAPER_NEWTON`` is defined).
+    Mirrors ``sv_first_root_bracketed`` in ``glsl/lib/core/roots.glsl`` line by line (``sv_first_root``
+    dispatches to it unless ``SV_ROOTS_PAPER`` is defined).
 
     Method
     ------
@@ -108,6 +108,17 @@ def first_root_bracketed(c, iterations: int = 8, *, dtype=np.float64):
         polynomial gives 0; non-finite coefficients give NaN. Coefficients so large that ``n (c_{k+1} - c_k)``
         or the de Casteljau sums overflow (|c| ~ 1e38 in float32) are outside the contract: the GPU's
         inf/NaN propagation may then differ from this twin.
+
+    Examples
+    --------
+    ``(t - 1/4)(t - 3/4)`` and the touching ``(t - 1/2)^2`` (a tangential ray), elevated to quartics:
+
+    >>> round(float(first_root_bracketed([3 / 16, -1 / 16, -7 / 48, -1 / 16, 3 / 16])), 12)
+    0.25
+    >>> c = np.array([0.25, 0.0, -1 / 12, 0.0, 0.25])
+    >>> r32 = first_root_bracketed(c.astype(np.float32), dtype=np.float32)
+    >>> float(first_root_bracketed(c)), float(r32), r32.dtype
+    (0.5, 0.5, dtype('float32'))
     """
     c = _check_univariate(c, finite=False)
     if (isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer))

@@ -14,7 +14,7 @@ __all__ = ["first_root_quadratic", "first_root_cubic", "CUBIC_POLISH"]
 def first_root_quadratic(c, *, dtype=np.float64):
     """First root in [0, 1] of a quadratic BB polynomial by the stable closed form (NaN if none).
 
-    Mirrors ``sv_first_root_quadratic`` in ``glsl/lib/roots.glsl`` operation by operation:
+    Mirrors ``sv_first_root_quadratic`` in ``glsl/lib/core/roots.glsl`` operation by operation:
     ``f = A t^2 + B t + C`` with ``A = c0 - 2 c1 + c2``, ``B = 2 (c1 - c0)``, ``C = c0``;
     ``q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2``, roots ``q / A`` and ``C / q``; ``c0 = 0`` gives 0; ``A = 0``
     the linear root ``-C / B``; a negative discriminant returns the vertex ``-B / (2A)`` if it passes the
@@ -26,6 +26,11 @@ def first_root_quadratic(c, *, dtype=np.float64):
         BB coefficients.
     dtype : numpy float type
         np.float32 reproduces the GPU's arithmetic; np.float64 is the reference precision.
+
+    Examples
+    --------
+    >>> first_root_quadratic([[3 / 16, -5 / 16, 3 / 16], [1.0, 2.0, 1.0]])  # (t - 1/4)(t - 3/4); no root
+    array([0.25,  nan])
     """
     c = _check_univariate(c, high=2)
     if c.shape[-1] != 3:
@@ -62,13 +67,13 @@ def first_root_quadratic(c, *, dtype=np.float64):
     return np.where(best <= 1, best, np.nan).astype(np.float64)
 
 
-#: Newton steps polishing the closed-form candidates (``SV_CUBIC_POLISH`` in ``glsl/lib/roots.glsl``).
+#: Newton steps polishing the closed-form candidates (``SV_CUBIC_POLISH`` in ``glsl/lib/core/roots.glsl``).
 CUBIC_POLISH = 1
 _SQRT3 = 1.7320508075688772
 
 
 def _cardano_real(P, Q, R, dt):
-    """mirrors glsl/lib/roots.glsl sv_cardano_real: real root of y^3 + 3 P y + Q, R = sqrt(Q^2 + 4 P^3)."""
+    """mirrors glsl/lib/core/roots.glsl sv_cardano_real: real root of y^3 + 3 P y + Q, R = sqrt(Q^2 + 4 P^3)."""
     s = dt(-0.5) * (Q + np.where(Q >= 0.0, R, -R))                 # s = -0.5 * (Q + (Q >= 0 ? R : -R))
     u = (np.sign(s) * np.power(np.abs(s), dt(1.0 / 3.0))).astype(dt)  # sign(s) * pow(abs(s), 1.0 / 3.0)
     v = np.where(u != 0.0, -P / np.where(u != 0.0, u, dt(1.0)), dt(0.0))
@@ -78,7 +83,7 @@ def _cardano_real(P, Q, R, dt):
 def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
     """First root in [0, 1] of cubic BB polynomials by a stable closed form (NaN if none).
 
-    Mirrors ``sv_first_root_cubic`` in ``glsl/lib/roots.glsl`` operation by operation (the GLSL's
+    Mirrors ``sv_first_root_cubic`` in ``glsl/lib/core/roots.glsl`` operation by operation (the GLSL's
     ``atan``, ``cos``, ``sin``, ``pow``, ``log2`` and ``exp2`` are not correctly rounded, so the float32
     twin agrees with the GPU only after the Newton polish, within the root's rounding level).
 
@@ -116,6 +121,15 @@ def first_root_cubic(c, *, dtype=np.float64, polish: int = CUBIC_POLISH):
     -------
     ndarray, shape ``c.shape[:-1]``
         First root, NaN if none. ``c0 == 0`` (including the zero polynomial) gives 0.
+
+    Examples
+    --------
+    ``(t - 1/4)(t - 3/4)`` elevated to a cubic, in float64 and as the GPU computes it:
+
+    >>> c = np.array([3 / 16, -7 / 48, -7 / 48, 3 / 16])
+    >>> r32 = first_root_cubic(c.astype(np.float32), dtype=np.float32)
+    >>> round(float(first_root_cubic(c)), 12), float(r32), r32.dtype
+    (0.25, 0.25, dtype('float32'))
     """
     c = _check_univariate(c, high=3, finite=False)
     if c.shape[-1] != 4:

@@ -1,8 +1,8 @@
 """Newton iteration from fixed starting points, the papers' GPU root finders (line-by-line twins).
 
-* :func:`newton_secure` -- [Reis2008]'s method (``sv_first_root_newton4``): four starts ``(0, w0, w1, 1)``,
+* :func:`newton_secure` -- the method of [Reis2008, sec. V] (``sv_first_root_newton4``): four starts ``(0, w0, w1, 1)``,
   the end points and the inflection points, for degree <= 4.
-* :func:`newton_three_starts` -- [Kalbe2008]'s method (``sv_first_root_newton3``): three starts
+* :func:`newton_three_starts` -- the method of [Kalbe2008, sec. 5.3] (``sv_first_root_newton3``): three starts
   ``(0, w, 1)`` for cubics.
 
 Both take the smallest iterate in [0, 1] that passes the residual test of
@@ -40,11 +40,11 @@ def _newton_from_starts(cc, n, x, iterations, dtype):
 def newton_secure(c, iterations: int = 6, *, dtype=np.float64, return_candidates: bool = False):
     """First root in [0, 1] by Newton iteration from secure starting points (the GPU method).
 
-    The method of [Reis2008]. Mirrors ``sv_first_root_newton4`` in ``glsl/lib/roots.glsl`` line by line
-    (``sv_first_root`` with ``SV_ROOTS_PAPER_NEWTON`` defined):
+    The method of [Reis2008, sec. V]. Mirrors ``sv_first_root_newton4`` in ``glsl/lib/core/roots.glsl``
+    line by line (``sv_first_root`` with ``SV_ROOTS_PAPER`` defined):
 
     1. inflection points ``w0 <= w1`` (roots of ``f''``); ``w0 := 1/3`` unless in (0, 1), ``w1 := 2/3``
-       unless in (0, 1) ([Reis2008], sec. VI pseudo-code);
+       unless in (0, 1) (the pseudo-code of [Reis2008, sec. V]);
     2. ``iterations`` Newton steps ``x <- x - f(x)/f'(x)`` from each of ``x = (0, w0, w1, 1)``; a start
        with ``f'(x) = 0`` or a non-finite step keeps its ``x``; nothing is clamped;
     3. the result is the smallest of the four ``x`` in [0, 1] with
@@ -66,6 +66,13 @@ def newton_secure(c, iterations: int = 6, *, dtype=np.float64, return_candidates
     -------
     ndarray, shape ``c.shape[:-1]``
         The first accepted root, NaN if none (the GLSL returns -1.0). The zero polynomial gives 0.
+
+    Examples
+    --------
+    >>> float(newton_secure([3 / 16, -1 / 16, -7 / 48, -1 / 16, 3 / 16]))  # (t - 1/4)(t - 3/4)
+    0.25
+    >>> float(newton_secure([0.25, 0.0, -1 / 12, 0.0, 0.25]))  # (t - 1/2)^2: a double root it misses
+    nan
     """
     c = _check_univariate(c)
     if isinstance(iterations, bool) or not isinstance(iterations, (int, np.integer)) or not 1 <= iterations <= 8:
@@ -89,7 +96,7 @@ def newton_secure(c, iterations: int = 6, *, dtype=np.float64, return_candidates
 def newton_three_starts(c, iterations: int = 5, *, dtype=np.float64):
     """First root in [0, 1] of cubic BB polynomials by [Kalbe2008]'s Newton from three starts (NaN if none).
 
-    Mirrors ``sv_first_root_newton3`` in ``glsl/lib/roots.glsl`` line by line: ``iterations`` Newton steps
+    Mirrors ``sv_first_root_newton3`` in ``glsl/lib/core/roots.glsl`` line by line: ``iterations`` Newton steps
     from ``0``, the inflection point ``w`` (root of ``f''``; ``1/2`` unless in (0, 1)) and ``1`` ([Kalbe2008],
     sec. 5.3, ``I = 5``), then the smallest iterate in [0, 1] passing the residual test
     ``|f(x)| <= K_3 EPS32 sum |c_k| B_k(x)`` of :func:`newton_secure`. A start with ``f' = 0`` or a
@@ -102,6 +109,12 @@ def newton_three_starts(c, iterations: int = 5, *, dtype=np.float64):
     iterations : int
         1..8.
     dtype : {numpy.float64, numpy.float32}
+
+    Examples
+    --------
+    >>> c = [3 / 16, -7 / 48, -7 / 48, 3 / 16]  # (t - 1/4)(t - 3/4)
+    >>> round(float(newton_three_starts(c)), 12)
+    0.25
     """
     c = _check_univariate(c, high=3)
     if c.shape[-1] != 4:

@@ -104,6 +104,14 @@ def roots_reference(c) -> np.ndarray:
     rounding level being multiple roots. Eigenvalue candidates are polished by 20 float64 Newton steps
     (a step is taken only if it lowers ``|f|``) and kept if ``|f(x)| <= 16 n eps64 sum |c_k| B_k(x)``;
     candidates closer than 1e-7 are merged.
+
+    Examples
+    --------
+    >>> roots_reference([3 / 16, -1 / 16, -7 / 48, -1 / 16, 3 / 16])  # (t - 1/4)(t - 3/4)
+    array([0.25, 0.75,  nan,  nan])
+    >>> roots_reference([[0.25, -0.25, 0.25], [1.0, 2.0, 1.0]])  # a double root 1/2; none
+    array([[0.5, nan],
+           [nan, nan]])
     """
     c = _check_univariate(c)
     lead = c.shape[:-1]
@@ -187,5 +195,11 @@ def roots_reference(c) -> np.ndarray:
 
 
 def first_root_reference(c) -> np.ndarray:
-    """Smallest root in [0, 1] by :func:`roots_reference`, NaN if none; shape ``c.shape[:-1]``."""
+    """Smallest root in [0, 1] by :func:`roots_reference`, NaN if none; shape ``c.shape[:-1]``.
+
+    Examples
+    --------
+    >>> first_root_reference([[3 / 16, -5 / 16, 3 / 16], [1.0, 2.0, 1.0]])
+    array([0.25,  nan])
+    """
     return roots_reference(c)[..., 0]

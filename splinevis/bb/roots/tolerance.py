@@ -32,7 +32,13 @@ def root_tolerance_k(n: int) -> float:
     ``gamma_{3n} S`` unless the root is argument-ill-conditioned (those cases are classified in the
     self-test). S itself is computed with relative error ``gamma_{3n}`` and ``K eps S`` costs two more
     roundings, so ``K_n = 2 gamma_{3n} / eps32 / (1 - gamma_{3n}) (1 + u)^2 <= 3n (1 + 2^-16)`` for
-    n <= 4. Same expression as ``sv_root_tol_k`` in ``glsl/lib/roots.glsl``.
+    n <= 4. Same expression as ``sv_root_tol_k`` in ``glsl/lib/core/roots.glsl`` ([Higham2002, sec. 3.4]
+    for gamma; [MainarPena1999] for the de Casteljau bound).
+
+    Examples
+    --------
+    >>> root_tolerance_k(4)  # 3 n (1 + 2^-16)
+    12.00018310546875
     """
     return 3.0 * float(n) * (1.0 + 2.0**-16)
 
