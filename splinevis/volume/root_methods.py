@@ -151,7 +151,7 @@ def first_root_tolerance(c, r):
     >>> (first_root_tolerance(c, np.array([0.25, 0.5])) / 2.0 ** -23).round(1)
     array([   7.6, 4857.8])
     """
-    from ..selftest import EVAL_BOUND
+    from ..bb.float32_bounds import EVAL_BOUND
 
     c = np.asarray(c, dtype=np.float64)
     r = np.asarray(r, dtype=np.float64)
