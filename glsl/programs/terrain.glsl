@@ -34,9 +34,10 @@ vec2 sv_block_minmax(int level, ivec2 b) {
 
 void sv_load_cell(ivec2 c, out float b0[15], out float b1[15]) {
     float w[32];
-    int first = 8 * (c.y * int(sv_ncells.x) + c.x);
+    // 8 texels per cell starting at a multiple of 8: one table row (lib/core/table.glsl)
+    ivec2 first = sv_table_address(8 * (c.y * int(sv_ncells.x) + c.x));
     for (int q = 0; q < 8; ++q) {
-        vec4 v = sv_table_texel(sv_terrain_coef, first + q);
+        vec4 v = texelFetch(sv_terrain_coef, first + ivec2(q, 0), 0);
         w[4 * q] = v.x; w[4 * q + 1] = v.y; w[4 * q + 2] = v.z; w[4 * q + 3] = v.w;
     }
     for (int q = 0; q < 15; ++q) {

@@ -3,7 +3,7 @@
 Each is a :class:`~splinevis.gl.contract.HardCase` that the tests and the self-test render and compare per
 pixel (:func:`splinevis.analysis.agreement.depth_agreement`): grazing rays, rays along grid lines and through
 vertices, the underside, a camera inside the bounding box, UTM-sized coordinates, extreme zoom, flat and almost
-flat data. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
+flat data, and a grid wider than a texture row. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
 """
 
 from __future__ import annotations
@@ -67,6 +67,15 @@ def _flat(almost: bool):
     return TerrainSpline.from_heights(z, "C1", spacing=(1.0, 1.0))
 
 
+def _wide():
+    # 2500 cells in x: 20,000 coefficient texels per grid row, more than a texture row holds (16,384 on llvmpipe
+    # and most GPUs); the linear tables must wrap rows without a seam
+    from datasets_synthetic.dem_files import fractal_terrain
+
+    z = np.tile(fractal_terrain(129, seed=2, amplitude=40.0)[:33], (1, 20))[:, :2501]
+    return TerrainSpline.from_heights(z, "C2", spacing=(1.0, 1.0))
+
+
 def hard_cases() -> list:
     """The terrain's hard cases (module docstring), 400 x 300 pixels each.
 
@@ -93,4 +102,6 @@ def hard_cases() -> list:
         HardCase("extreme-zoom", _franke, _zoom_camera, size, clipping_range=(1e-4, 2.0), min_hits=0.05),
         HardCase("flat", functools.partial(_flat, False), flat_view, size, min_hits=0.05),
         HardCase("almost-flat", functools.partial(_flat, True), flat_view, size, min_hits=0.05),
+        HardCase("wider-than-a-texture-row", _wide, [(2290.0, -25.0, 70.0), (2330.0, 16.0, 15.0), (0, 0, 1)], size,
+                 min_hits=0.05),
     ]

@@ -3,8 +3,14 @@
 // splinevis.gl.proxies.pack_rgba32f; the width is the same for every program (a test checks the two).
 const int SV_TABLE_WIDTH = 8192;
 
+// Texture coordinates of texel n. A record of k texels starting at a multiple of k, k dividing
+// SV_TABLE_WIDTH, lies in one row: fetch it at sv_table_address(first) + ivec2(q, 0).
+ivec2 sv_table_address(int n) {
+    return ivec2(n % SV_TABLE_WIDTH, n / SV_TABLE_WIDTH);
+}
+
 vec4 sv_table_texel(sampler2D table, int n) {
-    return texelFetch(table, ivec2(n % SV_TABLE_WIDTH, n / SV_TABLE_WIDTH), 0);
+    return texelFetch(table, sv_table_address(n), 0);
 }
 
 // Float number n of the table (four per texel).
