@@ -78,6 +78,31 @@ def _cmd_study(args) -> int:
 
 
 def main(argv=None) -> int:
+    """Run the ``splinevis`` command with ``argv`` (default: ``sys.argv[1:]``); returns the exit code.
+
+    Examples
+    --------
+    ``info`` prints what OpenGL the VTK windows and the moderngl context get, as JSON:
+
+    >>> from splinevis.cli import main
+    >>> main(["info"])
+    {
+      "vendor": ...
+      "moderngl": {
+        "GL_VENDOR": ...,
+        "GL_RENDERER": ...,
+        "GL_VERSION": ...
+      }
+    }
+    0
+
+    Bad usage exits with code 2 (argparse's message goes to stderr):
+
+    >>> main(["study", "sphere", "--out", "results"])
+    Traceback (most recent call last):
+    ...
+    SystemExit: 2
+    """
     from .studies import STUDIES
 
     parser = argparse.ArgumentParser(prog="splinevis", description="Exact per-pixel rendering of spline models.")

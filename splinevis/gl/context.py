@@ -60,6 +60,15 @@ def get_context():
     OpenGLUnavailableError
         When no context can be created; the message names the Debian packages that provide EGL and
         Mesa's software rasterizer.
+
+    Examples
+    --------
+    >>> from splinevis.gl.context import get_context
+    >>> ctx = get_context()
+    >>> ctx is get_context()  # one context per process
+    True
+    >>> ctx.version_code >= 330
+    True
     """
     global _ctx, _own
     with _lock:
@@ -140,6 +149,12 @@ def max_texture_size() -> int:
     Returns
     -------
     int
+
+    Examples
+    --------
+    >>> from splinevis.gl.context import max_texture_size
+    >>> max_texture_size() >= 8192  # Mesa llvmpipe: 16384
+    True
     """
     return int(get_context().info.get("GL_MAX_TEXTURE_SIZE", 8192))
 

@@ -79,6 +79,20 @@ def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, r
         ``file:line`` origin in ``glsl/`` and the offending source text.
     OpenGLUnavailableError
         If no OpenGL context can be created.
+
+    Examples
+    --------
+    Value and derivative of the quadratics with Bernstein coefficients ``(0, 1, 0)`` at ``t = 1/2`` and
+    ``(1, 2, 4)`` at ``t = 1/4``, one row each (columns: three coefficients, then ``t``):
+
+    >>> from splinevis.gl.harness import run_glsl
+    >>> body = '''
+    ...     float c[5] = float[5](sv_in[0], sv_in[1], sv_in[2], 0.0, 0.0);
+    ...     sv_out[0] = sv_bernstein_eval(c, 2, sv_in[3]);
+    ...     sv_out[1] = sv_bernstein_deriv(c, 2, sv_in[3]);'''
+    >>> run_glsl('#include "lib/core/bernstein.glsl"\\n', body, [[0, 1, 0, 0.5], [1, 2, 4, 0.25]], 2)
+    array([[0.5   , 0.    ],
+           [1.5625, 2.5   ]], dtype=float32)
     """
     x = np.asarray(inputs)
     if x.ndim == 1:

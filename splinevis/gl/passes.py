@@ -100,6 +100,24 @@ def program_for(block: Assembled, outputs: int):
     ------
     ShaderCompileError
         With each driver log line mapped to its ``glsl/`` file and line.
+
+    Examples
+    --------
+    >>> from splinevis.gl.assembler import assemble
+    >>> from splinevis.gl.passes import program_for
+    >>> prog = program_for(assemble("passes/copy.glsl"), 1)
+    >>> "sv_src" in prog, prog is program_for(assemble("passes/copy.glsl"), 1)
+    (True, True)
+
+    A compile error names the line of the GLSL it came from (here line 1 of the text given):
+
+    >>> program_for(assemble("void main() { sv_frag_out0 = vec4(undefined_name); }\\n"), 1)
+    Traceback (most recent call last):
+    ...
+    splinevis.errors.ShaderCompileError: GLSL fragment shader failed to compile.
+    ...
+    line 4 (<string>:1): ...undefined_name...
+    ...
     """
     head = [GLSL_VERSION, *(f"out vec4 {_OUT}{j};" for j in range(outputs))]
     source = "\n".join(head) + "\n" + block.text
@@ -183,6 +201,19 @@ class Pass:
         Compile-time flags for :func:`splinevis.gl.assembler.assemble`.
     root : Path, optional
         Another GLSL root (tests use a temporary one).
+
+    Examples
+    --------
+    >>> from splinevis.gl.passes import Pass
+    >>> p = Pass("passes/binomial3.glsl", {"sv_src": "heights"}, "smooth", uniforms={"sv_axis": (1, 0)})
+    >>> p.inputs, p.outputs
+    ((('sv_src', 'heights'),), ('smooth',))
+    >>> Pass("passes/copy.glsl", ["sv_src"]).inputs  # a sequence: sampler name == texture name
+    (('sv_src', 'sv_src'),)
+    >>> Pass("void main() { sv_frag_out0 = vec4(1.0); }\\n")
+    Traceback (most recent call last):
+    ...
+    ValueError: Pass '<string>' has no inputs, so give its output shape=(H, W).
     """
 
     shader: str
@@ -224,11 +255,30 @@ class Pass:
 
     @property
     def label(self) -> str:
-        """The shader file, or ``"<string>"`` for GLSL text (for messages)."""
+        """The shader file, or ``"<string>"`` for GLSL text (for messages).
+
+        Examples
+        --------
+        >>> from splinevis.gl.passes import Pass
+        >>> Pass("passes/copy.glsl", {"sv_src": "x"}).label
+        'passes/copy.glsl'
+        >>> Pass("void main() { sv_frag_out0 = vec4(1.0); }\\n", shape=(1, 1)).label
+        '<string>'
+        """
         return "<string>" if "\n" in self.shader else self.shader
 
     def program(self):
-        """The compiled program (cached); raises :class:`ShaderCompileError` mapped to ``glsl/`` lines."""
+        """The compiled program (cached); raises :class:`ShaderCompileError` mapped to ``glsl/`` lines.
+
+        Examples
+        --------
+        >>> from splinevis.gl.passes import Pass
+        >>> prog = Pass("passes/binomial3.glsl", {"sv_src": "x"}, uniforms={"sv_axis": (1, 0)}).program()
+        >>> "sv_src" in prog, "sv_axis" in prog
+        (True, True)
+        >>> prog is Pass("passes/binomial3.glsl", {"sv_src": "y"}).program()  # same source: compiled once
+        True
+        """
         return program_for(assemble(self.shader, self.defines, root=self.root), len(self.outputs))
 
 
@@ -244,6 +294,19 @@ class PassChain:
     passes : tuple of Pass
     inputs : tuple of str
         Texture names the chain reads before any of its passes writes them: what :meth:`run` needs.
+
+    Examples
+    --------
+    Separable binomial smoothing, along x and then along y:
+
+    >>> from splinevis.gl.passes import Pass, PassChain
+    >>> chain = PassChain([
+    ...     Pass("passes/binomial3.glsl", {"sv_src": "h"}, "hx", uniforms={"sv_axis": (1, 0)}),
+    ...     Pass("passes/binomial3.glsl", {"sv_src": "hx"}, "hxy", uniforms={"sv_axis": (0, 1)})])
+    >>> chain
+    PassChain(['passes/binomial3.glsl', 'passes/binomial3.glsl'], inputs=['h'])
+    >>> chain.inputs  # "hx" is written by the first pass
+    ('h',)
     """
 
     def __init__(self, passes: Sequence[Pass]):
@@ -293,6 +356,38 @@ class PassChain:
         -------
         ndarray or moderngl.Texture, or a tuple of them when ``result`` is a sequence (or the last pass
         has several outputs and ``result`` is not given).
+
+        Examples
+        --------
+        The separable binomial smoothing of a spike (``[1, 2, 1] / 4`` along x, then along y):
+
+        >>> import numpy as np
+        >>> from splinevis.gl.passes import Pass, PassChain
+        >>> chain = PassChain([
+        ...     Pass("passes/binomial3.glsl", {"sv_src": "h"}, "hx", uniforms={"sv_axis": (1, 0)}),
+        ...     Pass("passes/binomial3.glsl", {"sv_src": "hx"}, "hxy", uniforms={"sv_axis": (0, 1)})])
+        >>> h = np.zeros((3, 3), dtype=np.float32)
+        >>> h[1, 1] = 16.0
+        >>> chain.run({"h": h})[:, :, 0]  # float32 (H, W, 4); channel 0 holds the heights
+        array([[1., 2., 1.],
+               [2., 4., 2.],
+               [1., 2., 1.]], dtype=float32)
+        >>> hx, hxy = chain.run({"h": h}, result=("hx", "hxy"))  # an intermediate texture too
+        >>> hx[:, :, 0]
+        array([[0., 0., 0.],
+               [4., 8., 4.],
+               [0., 0., 0.]], dtype=float32)
+
+        With ``readback=False`` the result stays on the GPU; the caller uses and releases it inside
+        :func:`splinevis.gl.context.current`:
+
+        >>> from splinevis.gl.context import current
+        >>> with current():
+        ...     tex = chain.run({"h": h}, readback=False)
+        ...     size = tex.size
+        ...     tex.release()
+        >>> size
+        (3, 3)
         """
         if result is None:
             outs = self.passes[-1].outputs

@@ -40,12 +40,38 @@ class Study:
     summary: str
 
     def run(self, out_dir, *, quick: bool = False, progress: bool = True) -> dict:
-        """Import the runner and run it (see the module docstring for what it writes and returns)."""
+        """Import the runner and run it (see the module docstring for what it writes and returns).
+
+        Examples
+        --------
+        A stand-in runner in a module of its own (the real ones take minutes):
+
+        >>> import json, sys, tempfile, types
+        >>> def tiny(out_dir, *, quick=False, progress=True):
+        ...     result = {"quick": quick, "cubic": {"available": False, "note": "no cubic here"}}
+        ...     Path(out_dir, "tiny.json").write_text(json.dumps(result))
+        ...     return result
+        >>> sys.modules["tiny_study"] = types.ModuleType("tiny_study")
+        >>> sys.modules["tiny_study"].run = tiny
+        >>> study = Study("tiny", "tiny_study:run", "a stand-in")
+        >>> with tempfile.TemporaryDirectory() as out:
+        ...     result = study.run(out, quick=True, progress=False)
+        ...     written = json.loads(study.json_file(out).read_text())
+        >>> result["quick"], written == result, notes(result)
+        (True, True, ['no cubic here'])
+        >>> del sys.modules["tiny_study"]
+        """
         module, _, function = self.runner.partition(":")
         return getattr(importlib.import_module(module), function)(out_dir, quick=quick, progress=progress)
 
     def json_file(self, out_dir) -> Path:
-        """The JSON file the study writes into ``out_dir``."""
+        """The JSON file the study writes into ``out_dir``.
+
+        Examples
+        --------
+        >>> STUDIES["volume"].json_file("results").as_posix()
+        'results/volume.json'
+        """
         return Path(out_dir) / f"{self.name}.json"
 
 

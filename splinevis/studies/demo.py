@@ -42,6 +42,19 @@ def _sky(h=128, w=256):
 
 
 def _effect_panels():
+    """The panels of ``effects.png``: ``(title, style)`` per panel, ``style`` the keywords of
+    :meth:`splinevis.Plotter.add_spline` (public as :data:`EFFECT_PANELS`; a function, because the texture
+    and environment panels make their images on each call).
+
+    Examples
+    --------
+    >>> from splinevis.studies.demo import EFFECT_PANELS
+    >>> [title for title, _ in EFFECT_PANELS()]  # doctest: +NORMALIZE_WHITESPACE
+    ['unlit colour', '1 light', '3 lights + specular', 'colormap (height)', 'texture', 'environment map',
+     'reflection lines', 'isophotes', 'normals', 'mean curvature']
+    >>> dict(EFFECT_PANELS())["3 lights + specular"]
+    {'lights': 3, 'specular': True}
+    """
     return [
         ("unlit colour", dict(lights=0)),
         ("1 light", dict(lights=1)),
@@ -60,7 +73,23 @@ EFFECT_PANELS = _effect_panels
 
 
 def composite_scene(window_size=(640, 480), style=None, sphere=True):
-    """A Plotter with the demo patch (and the sphere mesh) at the showcase camera."""
+    """A Plotter with the demo patch (and the sphere mesh) at the showcase camera.
+
+    Returns
+    -------
+    (Plotter, QuarticTrianglePatch, SplineActor)
+        The offscreen plotter (the caller closes it), the patch and its actor.
+
+    Examples
+    --------
+    >>> from splinevis.studies.demo import composite_scene
+    >>> pl, patch, actor = composite_scene((64, 48))
+    >>> type(patch).__name__, actor.program.name, len(pl.renderer.actors)  # the patch and the sphere
+    ('QuarticTrianglePatch', 'analytic_patch', 2)
+    >>> bool((pl.depth_buffer() < 1.0).any())  # something was drawn
+    True
+    >>> pl.close()
+    """
     import pyvista as pv
 
     from ..analytic import QuarticTrianglePatch

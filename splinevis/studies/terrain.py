@@ -63,7 +63,19 @@ def franke_terrain(n: int, scheme: str):
 
 
 def accuracy_table(sizes=(13, 25, 49, 97), schemes=("linear", "C0", "C1", "C2", "C2-cubic"), sites=100_000, seed=0):
-    """Relative RMS and max error (relative to the max data amplitude) over random sites in [0,1]^2."""
+    """Relative RMS and max error (relative to the max data amplitude) over random sites in [0,1]^2.
+
+    Examples
+    --------
+    13x13 samples of Franke's function, beside the numbers of the paper's Table I:
+
+    >>> from splinevis.studies.terrain import accuracy_table
+    >>> rows = accuracy_table(sizes=(13,), schemes=("linear", "C1"), sites=1000)
+    >>> [(r["scheme"], r["patches"], r["paper_rms_rel"]) for r in rows]
+    [('linear', 288, 0.0055), ('C1', 288, 0.0033)]
+    >>> rows[1]["rms_rel"] < rows[0]["rms_rel"]  # the C1 quartic beats the linear mesh
+    True
+    """
     franke, _ = _franke()
     rng = np.random.default_rng(seed)
     xy = rng.random((sites, 2))

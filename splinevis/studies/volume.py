@@ -69,7 +69,14 @@ __all__ = ["run_volume_study", "cubic_status", "exact_reference", "measure_splin
 
 
 def cubic_status() -> tuple:
-    """``(available, note)``: whether the cubic scheme builds and evaluates here."""
+    """``(available, note)``: whether the cubic scheme builds and evaluates here.
+
+    Examples
+    --------
+    >>> from splinevis.studies.volume import cubic_status
+    >>> cubic_status()
+    (True, 'cubic scheme available')
+    """
     try:
         from datasets_synthetic.volumes import sphere_distance
         from ..volume.model import VolumeSpline

@@ -27,7 +27,17 @@ CLIP = (1.0, 6.0)
 
 # ------------------------------------------------------------------------------------------ approximation
 def approximation_rows(sizes=(16, 32, 64, 128), schemes=("trilinear", "quadratic", "cubic"), n_points=20000, progress=True):
-    """Approximation table rows (with ``field``) on Marschner-Lobb and the Gaussian blob."""
+    """Approximation table rows (with ``field``) on Marschner-Lobb and the Gaussian blob.
+
+    Examples
+    --------
+    >>> from splinevis.studies.volume_accuracy import approximation_rows
+    >>> rows = approximation_rows(sizes=(8, 16), schemes=("trilinear",), n_points=1000, progress=False)
+    >>> [(r["field"], r["n"]) for r in rows]
+    [('marschner_lobb', 8), ('marschner_lobb', 16), ('blob', 8), ('blob', 16)]
+    >>> round(rows[-1]["order_value_max"], 1)  # observed order on the smooth blob, heading for 2
+    1.8
+    """
     from datasets_synthetic.volumes import blob, marschner_lobb
     from ..volume.approximation import approximation_table
 
@@ -40,13 +50,39 @@ def approximation_rows(sizes=(16, 32, 64, 128), schemes=("trilinear", "quadratic
 
 # ------------------------------------------------------------------------------------------ the exact surface
 def set_camera(pl, camera=CAMERA, clip=CLIP):
-    """Put the study camera (or ``camera``) on a plotter, with a fixed clipping range."""
+    """Put the study camera (or ``camera``) on a plotter, with a fixed clipping range.
+
+    Examples
+    --------
+    >>> from splinevis.plotting import Plotter
+    >>> from splinevis.studies.volume_accuracy import set_camera
+    >>> pl = Plotter(off_screen=True, window_size=(32, 24))
+    >>> set_camera(pl)
+    >>> pl.camera.position, pl.camera.focal_point, pl.camera.clipping_range
+    ((1.5, -2.0, 1.6), (0.0, 0.0, 0.0), (1.0, 6.0))
+    >>> pl.close()
+    """
     pl.camera_position = camera
     pl.camera.clipping_range = clip
 
 
 def unproject(matrix, depth):
-    """World points (H, W, 3) of window depths (H, W) (row 0 at the top); NaN where depth >= 1."""
+    """World points (H, W, 3) of window depths (H, W) (row 0 at the top); NaN where depth >= 1.
+
+    Examples
+    --------
+    With the identity matrix world coordinates are normalized device coordinates (depth 0 is the near
+    plane z = -1, depth 1 the far plane: background):
+
+    >>> import numpy as np
+    >>> from splinevis.studies.volume_accuracy import unproject
+    >>> unproject(np.eye(4), [[0.5, 1.0], [0.0, 0.5]])
+    array([[[-0.5,  0.5,  0. ],
+            [ nan,  nan,  nan]],
+    <BLANKLINE>
+           [[-0.5, -0.5, -1. ],
+            [ 0.5, -0.5,  0. ]]])
+    """
     depth = np.asarray(depth, dtype=np.float64)
     h, w = depth.shape
     inv = np.linalg.inv(np.asarray(matrix, dtype=np.float64))
@@ -61,7 +97,42 @@ def unproject(matrix, depth):
 
 
 class Reference:
-    """The exact surface per pixel: rays, exact hit parameter, coverage, hit points and normals."""
+    """The exact surface per pixel: rays, exact hit parameter, coverage, hit points and normals.
+
+    Parameters
+    ----------
+    field : AnalyticField
+        With ``ray_hit`` (exact ray hits), ``normal`` and ``closest_point``, such as the torus.
+    grid : VolumeGrid
+        The samples the methods see; its spacing ``h`` is the unit of the position errors.
+    window : (W, H)
+    matrix : (4, 4) array_like
+        The camera's world-to-clip matrix (:meth:`splinevis.Plotter.camera_matrix`).
+
+    Examples
+    --------
+    With the identity matrix the rays run along z, down the axis of the torus: the covered pixels form a
+    ring.
+
+    >>> import numpy as np
+    >>> from datasets_synthetic.volumes import torus_distance
+    >>> from splinevis.studies.volume_accuracy import Reference
+    >>> field = torus_distance()  # R = 0.6, r = 0.25 about the z axis
+    >>> ref = Reference(field, field.sample(8), (8, 8), np.eye(4))
+    >>> ref.covered.astype(int)
+    array([[0, 0, 0, 0, 0, 0, 0, 0],
+           [0, 0, 1, 1, 1, 1, 0, 0],
+           [0, 1, 1, 1, 1, 1, 1, 0],
+           [0, 1, 1, 0, 0, 1, 1, 0],
+           [0, 1, 1, 0, 0, 1, 1, 0],
+           [0, 1, 1, 1, 1, 1, 1, 0],
+           [0, 0, 1, 1, 1, 1, 0, 0],
+           [0, 0, 0, 0, 0, 0, 0, 0]])
+    >>> bool(np.abs(field.value(ref.points[ref.covered])).max() < 1e-12)  # the hits are on the torus
+    True
+    >>> ref.h == 2 / 7  # 8 samples across [-1, 1]
+    True
+    """
 
     def __init__(self, field, grid, window, matrix):
         from ..gl.camera import pixel_rays
@@ -83,7 +154,17 @@ class Reference:
 
 
 def exact_reference(field, grid, window=WINDOW, camera=CAMERA, clip=CLIP) -> Reference:
-    """The study camera's exact per-pixel reference of ``field``'s isosurface (needs ``field.ray_hit``)."""
+    """The study camera's exact per-pixel reference of ``field``'s isosurface (needs ``field.ray_hit``).
+
+    Examples
+    --------
+    >>> from datasets_synthetic.volumes import torus_distance
+    >>> from splinevis.studies.volume_accuracy import exact_reference
+    >>> field = torus_distance()
+    >>> ref = exact_reference(field, field.sample(8), window=(32, 24))
+    >>> ref.covered.shape, int(ref.covered.sum())  # (H, W) and the pixels the exact torus covers
+    ((24, 32), 356)
+    """
     import pyvista as pv
 
     from ..plotting import Plotter
@@ -132,7 +213,22 @@ def _errors(ref: Reference, covered, points=None, normals=None) -> dict:
 # ------------------------------------------------------------------------------------------ the methods
 def measure_spline(ref: Reference, spline, *, roots=None, iterations=2, encoding="data", proxy="blocks",
                    repeats=3) -> dict:
-    """One spline configuration: GPU frame time and coverage; positions and normals from the float64 twin."""
+    """One spline configuration: GPU frame time and coverage; positions and normals from the float64 twin.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.volumes import torus_distance
+    >>> from splinevis.studies.volume_accuracy import exact_reference, measure_spline
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> field = torus_distance()
+    >>> grid = field.sample(8)
+    >>> ref = exact_reference(field, grid, window=(32, 24))
+    >>> row = measure_spline(ref, VolumeSpline(grid, "quadratic"), repeats=1)
+    >>> row["method"], row["config"], row["elements"]
+    ('quadratic spline', 'blocks, data, analytic', 800)
+    >>> row["gpu_twin_coverage_disagree"]  # the GPU covers exactly the pixels its float64 twin hits
+    0
+    """
     from ..plotting import Plotter
     from ..programs import program_for
     from ..volume.isosurface import Isosurface
@@ -181,7 +277,20 @@ def _mesh_normals_at(mesh, points):
 
 
 def measure_mesh(ref: Reference, *, method="flying_edges", upsample=1, repeats=3) -> dict:
-    """Marching cubes mesh, smooth-shaded: frame time, coverage and depth from the GPU, interpolated normals."""
+    """Marching cubes mesh, smooth-shaded: frame time, coverage and depth from the GPU, interpolated normals.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.volumes import torus_distance
+    >>> from splinevis.studies.volume_accuracy import exact_reference, measure_mesh
+    >>> field = torus_distance()
+    >>> ref = exact_reference(field, field.sample(8), window=(32, 24))
+    >>> row = measure_mesh(ref, upsample=1, repeats=1)
+    >>> row["method"], row["config"], row["elements"]
+    ('MC flying_edges', 'upsample 1x', 208)
+    >>> row["pixels_exact"], row["position_err_median_h"] < 0.5  # shown points within half a grid spacing
+    (356, True)
+    """
     from ..plotting import Plotter
     from ..volume.baselines import marching_cubes_mesh
 
@@ -213,7 +322,22 @@ _SIGNS = np.array([[1, sy, sz] for sy in (1, -1) for sz in (1, -1)], dtype=np.fl
 def normals_from_two_sided(intensity):
     """Normals (n, 3) from two-sided diffuse intensities ``|n . L|`` (n, 6) under :data:`_LIGHTS`: the axis
     intensities are the magnitudes; the sign pattern (x taken positive) best explaining the diagonal ones
-    is chosen."""
+    is chosen.
+
+    Examples
+    --------
+    Two unit normals, lit from the three axes and the three diagonals (the first comes back with x
+    positive: VTK's two-sided lighting cannot tell a normal from its opposite):
+
+    >>> import numpy as np
+    >>> from splinevis.studies.volume_accuracy import normals_from_two_sided
+    >>> lights = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [1, 0, 1], [0, 1, 1]])
+    >>> lights = lights / np.linalg.norm(lights, axis=1, keepdims=True)
+    >>> normals = np.array([[-0.6, 0.8, 0.0], [0.48, 0.6, -0.64]])
+    >>> normals_from_two_sided(np.abs(normals @ lights.T))
+    array([[ 0.6 , -0.8 ,  0.  ],
+           [ 0.48,  0.6 , -0.64]])
+    """
     mag = intensity[:, :3]
     cand = mag[:, None, :] * _SIGNS[None]  # (n, 4, 3)
     pred = np.abs(cand @ _LIGHTS[3:].T)  # (n, 4, 3)
@@ -222,7 +346,20 @@ def normals_from_two_sided(intensity):
 
 
 def measure_vtk(ref: Reference, *, sample_distance=None, repeats=3) -> dict:
-    """VTK's GPU isosurface ray caster: frame time, coverage from the image, normals by the lighting trick."""
+    """VTK's GPU isosurface ray caster: frame time, coverage from the image, normals by the lighting trick.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.volumes import torus_distance
+    >>> from splinevis.studies.volume_accuracy import exact_reference, measure_vtk
+    >>> field = torus_distance()
+    >>> ref = exact_reference(field, field.sample(8), window=(32, 24))
+    >>> row = measure_vtk(ref, sample_distance=ref.h / 4, repeats=1)
+    >>> row["method"], row["config"], row["position_err_median_h"]  # VTK's volume writes no depth
+    ('VTK volume', 'sample distance h/4', None)
+    >>> row["quantisation_floor_median_deg"] < 1.0  # what 8-bit renders allow to measure of the normals
+    True
+    """
     import pyvista as pv
 
     from ..plotting import Plotter
@@ -267,7 +404,17 @@ def measure_vtk(ref: Reference, *, sample_distance=None, repeats=3) -> dict:
 # ------------------------------------------------------------------------------------------ the sweep
 def spline_configs(quick, cubic):
     """(scheme, encoding, roots, iterations, proxy) of the measured spline programs. The Newton iteration
-    of [Kalbe2008] (``"paper"``) exists for the cubic only: the paper solves quadratics in closed form."""
+    of [Kalbe2008] (``"paper"``) exists for the cubic only: the paper solves quadratics in closed form.
+
+    Examples
+    --------
+    >>> from splinevis.studies.volume_accuracy import spline_configs
+    >>> spline_configs(quick=True, cubic=False)
+    [('quadratic', 'data', 'analytic', 1, 'blocks'), ('quadratic', 'coefficients', 'analytic', 1, 'blocks'),
+     ('quadratic', 'data', 'analytic', 1, 'cubes')]
+    >>> len(spline_configs(quick=True, cubic=True)), len(spline_configs(quick=False, cubic=True))
+    (7, 14)
+    """
     q = [("quadratic", "data", "analytic", 1, "blocks"), ("quadratic", "coefficients", "analytic", 1, "blocks"),
          ("quadratic", "data", "analytic", 1, "cubes")]
     c = [("cubic", "data", "analytic", 1, "blocks"), ("cubic", "determining", "analytic", 1, "blocks"),

@@ -19,7 +19,23 @@ ML_CAMERA = [(0.55, -0.95, 0.75), (0.05, -0.05, -0.05), (0.0, 0.0, 1.0)]
 
 def approximation_figure(rows, path):
     """Value and gradient error against h (log-log) per field and scheme, with the slope between the two
-    finest grids, from :func:`splinevis.studies.volume_accuracy.approximation_rows`."""
+    finest grids, from :func:`splinevis.studies.volume_accuracy.approximation_rows`.
+
+    Examples
+    --------
+    Rows need ``field``, ``scheme``, ``h``, ``value_max`` and ``gradient_max``; here made up, second
+    order in the values and first order in the gradients:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from splinevis.studies.volume_figures import approximation_figure
+    >>> rows = [{"field": "blob", "scheme": "trilinear", "h": h, "value_max": h ** 2, "gradient_max": h}
+    ...         for h in (0.1, 0.05, 0.025)]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     approximation_figure(rows, Path(d) / "approximation.png")
+    ...     (Path(d) / "approximation.png").read_bytes()[1:4]
+    b'PNG'
+    """
     plt = pyplot()
     fields = sorted({r["field"] for r in rows})
     fig, axes = plt.subplots(1, 2 * len(fields), figsize=(4.2 * 2 * len(fields), 4))
@@ -52,7 +68,27 @@ def _short(r):
 
 def pareto_figure(rows, setup, path):
     """Median normal error and coverage mismatch against median frame time, one series per method, from
-    :func:`splinevis.studies.volume_accuracy.accuracy_vs_time`."""
+    :func:`splinevis.studies.volume_accuracy.accuracy_vs_time`.
+
+    Examples
+    --------
+    Two made-up rows (the keys the figure reads: ``method``, ``frame_median_ms``, the two errors and what
+    labels a point) and the set-up they were measured in:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from splinevis.studies.volume_figures import pareto_figure
+    >>> rows = [
+    ...     {"method": "MC flying_edges", "upsample": 1, "frame_median_ms": 5.0, "normal_err_median_deg": 2.0,
+    ...      "coverage_mismatch": 30},
+    ...     {"method": "quadratic spline", "encoding": "data", "roots": "analytic", "iterations": None,
+    ...      "frame_median_ms": 9.0, "normal_err_median_deg": 0.1, "coverage_mismatch": 0}]
+    >>> setup = {"field": "torus", "grid": "24^3", "h": 2 / 23, "window": [200, 150]}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     pareto_figure(rows, setup, Path(d) / "pareto.png")
+    ...     (Path(d) / "pareto.png").read_bytes()[1:4]
+    b'PNG'
+    """
     plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
     styles = {"MC skimage": ("k", "o"), "MC flying_edges": ("0.5", "s"), "VTK volume": ("tab:green", "^"),

@@ -49,7 +49,17 @@ PAPER_COLUMNS = [
 
 
 def memory_rows(sizes=(64, 128, 256), schemes=("quadratic", "cubic"), progress=True):
-    """Memory and preprocessing per Marschner-Lobb volume size and scheme (isovalue 0.5, then 0.45)."""
+    """Memory and preprocessing per Marschner-Lobb volume size and scheme (isovalue 0.5, then 0.45).
+
+    Examples
+    --------
+    >>> from splinevis.studies.volume_memory import memory_rows
+    >>> rows = memory_rows(sizes=(8,), schemes=("quadratic",), progress=False)
+    >>> [(r["volume"], r["scheme"], r["relevant_cubes"], r["relevant_tets"]) for r in rows]
+    [('8^3', 'quadratic', 116, 1344)]
+    >>> rows[0]["second_isovalue"], rows[0]["second_isovalue_cubes"]
+    (0.45, 112)
+    """
     from datasets_synthetic.volumes import marschner_lobb
     from ..volume.isosurface import Isosurface
     from ..volume.model import VolumeSpline
@@ -89,7 +99,23 @@ def memory_rows(sizes=(64, 128, 256), schemes=("quadratic", "cubic"), progress=T
 
 def memory_markdown(rows) -> list:
     """The markdown section of ``rows`` (from :func:`memory_rows`) and of the paper's table, as the parts
-    the study's report joins with newlines."""
+    the study's report joins with newlines.
+
+    Examples
+    --------
+    Rows need the keys of :data:`MEMORY_COLUMNS` (a missing one is a ``-`` cell) and ``n``; a 256^3 row
+    adds the line on the 5 s goal:
+
+    >>> from splinevis.studies.volume_memory import memory_markdown
+    >>> row = {"volume": "256^3", "n": 256, "scheme": "quadratic", "relevant_cubes": 120000, "preprocessing_s": 3.2}
+    >>> md = memory_markdown([row])
+    >>> print(md[1].splitlines()[2])
+    | 256^3 | quadratic | 120,000 | - | - | - | - | - | - | - | - | - | - | - | - | 3.20 | - |
+    >>> md[2]
+    '\\nGoal: 256^3 preprocessing for one isovalue <= 5 s: quadratic 3.20 s (met).\\n'
+    >>> md[3].splitlines()[1]  # the paper's numbers, labelled as such
+    '### paper (Kalbe & Zeilfelder 2008, Table 1, NVIDIA 8800 Ultra, 1280x1024; real data sets, not ours)'
+    """
     md = ["\n## 3. Memory and preprocessing (Marschner-Lobb, isovalue 0.5; layout of the paper's Table 1)\n",
           md_table(rows, MEMORY_COLUMNS)]
     big = [r for r in rows if r["n"] == 256]

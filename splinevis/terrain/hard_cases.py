@@ -83,7 +83,7 @@ def hard_cases() -> list:
     --------
     >>> cases = hard_cases()
     >>> len(cases), cases[0].name, cases[0].window_size, cases[5].clipping_range
-    (10, 'oblique', (400, 300), (0.001, 5.0))
+    (11, 'oblique', (400, 300), (0.001, 5.0))
     """
     size = (400, 300)
     grazing_z = 1.25
