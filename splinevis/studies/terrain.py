@@ -193,7 +193,7 @@ def _scene_mesh(n):
     franke, _ = _franke()
     t = np.linspace(0, 1, n)
     x, y = np.meshgrid(t, t, indexing="xy")
-    grid = pv.StructuredGrid(x, y, franke(x, y)).extract_surface().triangulate()
+    grid = pv.StructuredGrid(x, y, franke(x, y)).extract_surface(algorithm='dataset_surface').triangulate()
     pl = Plotter(off_screen=True, window_size=WINDOW)
     pl.add_mesh(grid, color="tan", smooth_shading=True)
     pl.camera_position = CAMERA
