@@ -211,6 +211,8 @@ class Plotter(pv.Plotter):
 
         Examples
         --------
+        No :meth:`show` is needed first: the first call opens the window and compiles the programs.
+
         >>> from splinevis.analytic import QuarticTrianglePatch
         >>> pl = Plotter(off_screen=True, window_size=(64, 48))
         >>> actor = pl.add_spline(QuarticTrianglePatch.demo())

@@ -95,10 +95,13 @@ class QuarticTrianglePatch:
 
         Examples
         --------
-        >>> QuarticTrianglePatch(np.zeros(15), [[0, 0], [2, 0], [0, 2]]).barycentric_matrix
+        >>> M = QuarticTrianglePatch(np.zeros(15), [[0, 0], [2, 0], [0, 2]]).barycentric_matrix
+        >>> M
         array([[-0.5, -0.5,  1. ],
                [ 0.5,  0. ,  0. ],
                [ 0. ,  0.5,  0. ]])
+        >>> M @ [1.0, 1.0, 1.0]  # the point (1, 1): midway between the second and third vertex
+        array([0. , 0.5, 0.5])
         """
         return self._m
 

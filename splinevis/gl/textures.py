@@ -79,7 +79,6 @@ def upload_rgba32f(values, name: str = "values"):
 
     Examples
     --------
-    >>> from splinevis.gl.context import current
     >>> values = np.random.default_rng(0).random((2, 3, 4), dtype=np.float32)
     >>> texture = upload_rgba32f(values)
     >>> texture.size, bool((read_rgba32f(texture) == values).all())  # (width, height); exact round trip
@@ -104,7 +103,6 @@ def empty_rgba32f(shape):
 
     Examples
     --------
-    >>> from splinevis.gl.context import current
     >>> texture = empty_rgba32f((2, 3))
     >>> texture.size, texture.components, texture.dtype
     ((3, 2), 4, 'f4')
@@ -127,7 +125,6 @@ def read_rgba32f(texture) -> np.ndarray:
 
     Examples
     --------
-    >>> from splinevis.gl.context import current
     >>> texture = upload_rgba32f(np.full((1, 2), 0.1))  # one channel given, the others zero
     >>> read_rgba32f(texture)
     array([[[0.1, 0. , 0. , 0. ],

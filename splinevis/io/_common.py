@@ -216,7 +216,8 @@ def unsupported_extension(path: Path, extensions: dict, hint: str = "") -> Value
     Returns
     -------
     ValueError
-        For the caller to raise.
+        For the caller to raise (``raise unsupported_extension(...)``), so that the traceback ends in
+        the reader.
 
     Examples
     --------
@@ -435,7 +436,7 @@ def gap_error(source: str, count: int, size: int, what: str, position: str, valu
     Returns
     -------
     ValueError
-        For the caller to raise.
+        For the caller to raise, as with :func:`unsupported_extension`.
 
     Examples
     --------

@@ -69,13 +69,16 @@ def read_geotiff(path: Path, spacing, origin, nodata) -> HeightSamples:
 
     Examples
     --------
+    A 2 x 2 UTM GeoTIFF with one gap, written as ``nodata=-9999``; the values come as stored, north row
+    first (``flip_rows``):
+
     >>> import tempfile
     >>> from datasets_synthetic.dem_files import write_geotiff
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     path = write_geotiff(Path(folder) / "dem.tif", [[1.0, np.nan], [3.0, 4.0]], (10.0, 10.0),
     ...                          (100.0, 200.0), nodata=-9999, epsg=32633)
     ...     samples = read_geotiff(path, None, None, None)
-    >>> samples.values.tolist(), samples.missing.tolist()  # as stored: north row first; the gap is nodata
+    >>> samples.values.tolist(), samples.missing.tolist()
     ([[3.0, 4.0], [1.0, -9999.0]], [[False, False], [False, True]])
     >>> samples.flip_rows, [float(v) for v in samples.spacing + samples.origin], samples.crs
     (True, [10.0, 10.0, 100.0, 200.0], 'EPSG:32633')

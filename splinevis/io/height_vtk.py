@@ -34,10 +34,8 @@ def read_vtk_file(path: Path, description: str, scalars, nodata) -> HeightSample
         An existing ``.vti``, ``.vtk``, ``.vtr`` or ``.vts`` file.
     description : str
         The format, for the message when pyvista cannot read the file.
-    scalars : str or None
-        Name of the point array holding the heights.
-    nodata : float or None
-        Value marking missing samples besides NaN/inf.
+    scalars, nodata
+        As in :func:`from_pyvista`, which gets the grid read from the file.
 
     Returns
     -------

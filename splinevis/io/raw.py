@@ -64,13 +64,15 @@ def read_raw(path: Path, shape, dtype, byteorder, header_bytes, spacing, origin,
 
     Examples
     --------
+    Big-endian uint16 samples, x fastest, come back in native byte order:
+
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     path = Path(folder) / "ct.raw"
-    ...     _ = path.write_bytes(np.arange(24, dtype=">u2").tobytes())  # big-endian uint16, x fastest
+    ...     _ = path.write_bytes(np.arange(24, dtype=">u2").tobytes())
     ...     samples = read_raw(path, (2, 3, 4), "uint16", "big", 0, (0.5, 0.5, 2.0), None, None)
-    >>> samples.values.dtype.name, int(samples.values[1, 2, 3]), samples.spacing  # read in native order
-    ('uint16', 23, (0.5, 0.5, 2.0))
+    >>> samples.values.dtype, int(samples.values[1, 2, 3]), samples.spacing
+    (dtype('uint16'), 23, (0.5, 0.5, 2.0))
     """
     missing = [n for n, v in (("shape", shape), ("dtype", dtype)) if v is None]
     if missing:

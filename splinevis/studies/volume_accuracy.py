@@ -350,12 +350,14 @@ def measure_vtk(ref: Reference, *, sample_distance=None, repeats=3) -> dict:
 
     Examples
     --------
+    VTK's volume rendering writes no depth: coverage and normals are measured, positions are not.
+
     >>> from datasets_synthetic.volumes import torus_distance
     >>> from splinevis.studies.volume_accuracy import exact_reference, measure_vtk
     >>> field = torus_distance()
     >>> ref = exact_reference(field, field.sample(8), window=(32, 24))
     >>> row = measure_vtk(ref, sample_distance=ref.h / 4, repeats=1)
-    >>> row["method"], row["config"], row["position_err_median_h"]  # VTK's volume writes no depth
+    >>> row["method"], row["config"], row["position_err_median_h"]
     ('VTK volume', 'sample distance h/4', None)
     >>> row["quantisation_floor_median_deg"] < 1.0  # what 8-bit renders allow to measure of the normals
     True

@@ -61,12 +61,12 @@ def sample_field(field, n: int) -> np.ndarray:
 
     Examples
     --------
+    Sampling needs only ``bounds`` and ``value``:
+
     >>> class Square:  # f = x^2 on the unit cube
     ...     bounds = (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)
     ...     def value(self, p):
     ...         return p[:, 0] ** 2
-    ...     def gradient(self, p):
-    ...         return np.stack([2 * p[:, 0], 0 * p[:, 0], 0 * p[:, 0]], axis=1)
     >>> sample_field(Square(), 6)[0, 0]  # x = 0, 0.2, ..., 1
     array([0.  , 0.04, 0.16, 0.36, 0.64, 1.  ])
     """

@@ -141,8 +141,9 @@ class VolumeSpline:
     def shape(self) -> tuple:
         """``(nz, ny, nx)`` cubes (= data points).
 
-        >>> VolumeSpline(np.zeros((3, 4, 5))).shape
-        (3, 4, 5)
+        >>> s = VolumeSpline(np.zeros((3, 4, 5)))
+        >>> s.shape, s.padded.shape  # the padded data add a layer on every side
+        ((3, 4, 5), (5, 6, 7))
         """
         return self.grid.shape
 

@@ -163,19 +163,21 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
 
     Only what depends on the isovalue is rebuilt: the relevant cubes (found through the spline's existing
     min-max octree), the proxy geometry, the ``sv_iso_shifted`` uniform and, for ``encoding="coefficients"``,
-    the coefficient table. The data texture, the octree and the compiled program are kept (tested).
-    Returns the new :class:`Relevant`.
+    the coefficient table; an attached culler (:func:`attach_culling`) gets the new blocks. The data texture,
+    the octree and the compiled program are kept (tested). Returns the new :class:`Relevant`.
 
     Examples
     --------
     >>> from splinevis.plotting import Plotter
     >>> from splinevis.volume.hard_cases import sphere_grid
-    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
     >>> pl = Plotter(off_screen=True, window_size=(64, 48))
-    >>> actor = pl.add_spline(surface)
+    >>> actor = pl.add_isosurface(sphere_grid(12), 0.7)  # |x| on [-1, 1]^3: a sphere; culling attached
+    >>> blocks = len(actor.culler.units)
     >>> rel = set_isovalue(actor, 0.4)  # a smaller sphere: fewer cubes
     >>> len(rel.cubes), actor.model.isovalue, round(actor.extra_uniforms["sv_iso_shifted"], 9)
     (80, 0.4, -0.544754986)
+    >>> blocks, len(actor.culler.units)  # the culler tests only the blocks still holding cubes
+    (8, 4)
     >>> pl.close()
     """
     model = actor.model
@@ -213,11 +215,12 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
     --------
     >>> from splinevis.volume.hard_cases import sphere_grid
     >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)  # |x| on [-1, 1]^3: a sphere
-    >>> o, d = np.array([[0.0, 0.0, 3.0]]), np.array([[0.0, 0.0, -1.0]])
+    >>> o = np.array([[0.0, 0.0, 3.0], [3.0, 0.0, 0.0]])
+    >>> d = -o / 3  # two rays to the centre, along -z and -x
     >>> t = raycast_isosurface(surface, o, d).t
     >>> bound = isosurface_depth_bound(surface, np.eye(4), o, d, t)  # identity camera: depth (z + 1) / 2
-    >>> bool(0.0 < bound[0] < 1e-5)
-    True
+    >>> bound.shape, bool(np.all((0.0 < bound) & (bound < 1e-5)))  # one bound per hit
+    ((2,), True)
     """
     sp = model.spline
     off = sp.origin
