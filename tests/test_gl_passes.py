@@ -308,12 +308,3 @@ def test_vtk_texture_renders_a_pass_result_upright_after_our_context_was_used():
     # VTK's window terminates the EGL display it shares with our context when it is finalized
     win.Finalize()
     assert np.array_equal(run_passes([Pass(ADD_ONE, {"sv_src": "q"})], {"q": q}), q + 1)
-
-
-@pytest.mark.parametrize("module", ["splinevis.gl.context", "splinevis.gl.passes"])
-def test_docstring_examples_run(module):
-    import doctest
-    import importlib
-
-    result = doctest.testmod(importlib.import_module(module), optionflags=doctest.NORMALIZE_WHITESPACE)
-    assert result.attempted > 0 and result.failed == 0
