@@ -240,7 +240,8 @@ class Plotter(pv.Plotter):
     def depth_buffer(self) -> np.ndarray:
         """Window depth in [0, 1] per pixel, (H, W), row 0 at the top like :meth:`screenshot`.
 
-        Read straight from the framebuffer (pyvista's ``get_image_depth`` would reset the clipping range).
+        Read straight from the framebuffer (pyvista's ``get_image_depth`` would reset the clipping range); a
+        window that was never rendered is rendered first (its framebuffer would hold garbage).
 
         Examples
         --------
@@ -253,6 +254,8 @@ class Plotter(pv.Plotter):
         ((48, 64), 1.0, True)
         >>> pl.close()
         """
+        if self._first_time:
+            self.render_now()
         w, h = self.window_size
         from vtkmodules.vtkCommonCore import vtkFloatArray
 

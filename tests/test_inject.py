@@ -139,3 +139,12 @@ def test_float_texture_and_vertex_attribute_path_gives_the_same_image():
     assert surface.mean() > 0.1
     # Same float32 coefficients either way (RGBA32F texels are exact copies), so the same pixels.
     assert np.array_equal(images[0], images[1])
+
+
+def test_depth_buffer_before_any_render_renders_first():
+    # reading the framebuffer of a window never rendered returned uninitialised memory (NaN and garbage)
+    pl = splinevis.Plotter(off_screen=True, window_size=(64, 48))
+    pl.add_spline(QuarticTrianglePatch.demo())
+    depth = pl.depth_buffer()
+    pl.close()
+    assert np.isfinite(depth).all() and depth.max() == 1.0 and 0.0 < depth.min() < 1.0
