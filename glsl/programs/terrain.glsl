@@ -59,10 +59,17 @@ const float SV_CELL_MARGIN = 1.52587890625e-05;
 
 // First hit (t in [ta, tb]) of the cell-local ray o + t d with triangle `tri`; SV_NO_HIT if none
 // (t may be negative: rays start on the far side of the proxy, see lib/core/raycast.glsl).
+// The ray is rebased to the segment's start before its barycentric coordinates are taken: o is far from the
+// cell (the ray starts on the far side of the proxy, up to the grid's size away), and lam_o + t lam_d with
+// |lam_o| ~ that distance sums to 1 only within ~u times it, which scales the whole restricted polynomial:
+// on a flat plateau 90 m above the reference height that offset exceeded the slab and the ray missed
+// (pinholes on plateaus and valley floors). From a point in the cell the coordinates sum to 1 within a few u.
 float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
-    vec3 lo = sv_cell_bary(o.xy, tri);
+    vec3 start = o + ta * d;
+    vec3 lo = sv_cell_bary(start.xy, tri);
     vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
-    return sv_graph_patch_hit(b, lo, ld, o.z, d.z, ta, tb, SV_CELL_MARGIN, sv_newton_iterations);
+    float s = sv_graph_patch_hit(b, lo, ld, start.z, d.z, 0.0, tb - ta, SV_CELL_MARGIN, sv_newton_iterations);
+    return s == SV_NO_HIT ? SV_NO_HIT : ta + s;
 }
 
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
@@ -107,7 +114,11 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         vec2 mm = sv_block_minmax(L, c);
         float za = P0.z + t * D.z;
         float zb = P0.z + tb * D.z;
-        if (max(za, zb) >= mm.x && min(za, zb) <= mm.y) {
+        // The ray's heights carry the rounding of P0.z + t D.z (two roundings on terms up to |P0.z| and
+        // |t D.z|): widen the overlap test by it, or a crossing at a block's exit is skipped with the block
+        // and the next block is entered below the surface (pinholes on plateaus and crater rims).
+        float zerr = 2.384185791015625e-07 * (abs(P0.z) + max(abs(t), abs(tb)) * abs(D.z));
+        if (max(za, zb) + zerr >= mm.x && min(za, zb) - zerr <= mm.y) {
             if (L > 0) {
                 // Descend to the child holding P(t); clamp to c's children (P(t) may sit on a border).
                 L -= 1;

@@ -8,7 +8,24 @@ import numpy as np
 from . import roots as _roots
 from . import simplex as _simplex
 
-__all__ = ["graph_patch_first_hit"]
+__all__ = ["graph_patch_first_hit", "start_tolerance"]
+
+U32 = 2.0 ** -24
+
+
+def start_tolerance(b_max, z_max, L, z_range):
+    """Rounding error of the restricted coefficients c_k = f(ray) - z(ray) the shader computes in float32
+    (glsl/lib/simplex/graph_patch.glsl), within which a segment's start counts as on the surface.
+
+    Blossoming four levels of barycentric combinations of coefficients up to ``b_max`` and subtracting the
+    ray's height (up to ``z_max``): 32 u (b_max + z_max) [Higham2002, sec. 3.4]; the ray's barycentric
+    coordinates (magnitude ``L``) carry 4 u L, which moves a quartic by at most its barycentric slope
+    4 ``z_range``: 16 u L z_range.
+
+    >>> float(start_tolerance(1.0, 1.0, 1.0, 0.0)) == 64 * 2.0 ** -24
+    True
+    """
+    return U32 * (32.0 * (np.asarray(b_max) + np.asarray(z_max)) + 16.0 * np.asarray(L) * np.asarray(z_range))
 
 _K = np.arange(5) / 4.0
 
@@ -71,6 +88,16 @@ def graph_patch_first_hit(b, lam_o, lam_d, oz, dz, ta, tb, *, margin=0.0, method
     c = c - (z0[:, None] * (1 - _K) + z1[:, None] * _K)
     sign_change = (c.min(axis=-1) <= 0) & (c.max(axis=-1) >= 0)
     s = np.full(idx.shape, np.nan)
+    if method != "reference":
+        # the shader's rule: a segment starting on the surface within the float32 rounding of c is a hit at
+        # its start (see start_tolerance); the reference finds the true root instead
+        lam_a = lam_o[idx] + a[:, None] * lam_d[idx]
+        L = (np.abs(lam_a) + np.abs(e - a)[:, None] * np.abs(lam_d[idx])).max(axis=-1)
+        eps = start_tolerance(np.maximum(np.abs(zlo[idx]), np.abs(zhi[idx])), np.maximum(np.abs(z0), np.abs(z1)), L,
+                              zhi[idx] - zlo[idx])
+        at_start = np.abs(c[:, 0]) <= eps
+        s[at_start] = 0.0
+        sign_change &= ~at_start
     if sign_change.any():
         cc = c[sign_change]
         if method == "reference":

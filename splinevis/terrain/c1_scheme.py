@@ -1,5 +1,7 @@
 """The C1 terrain scheme: its data stencil and the derivation of its weights from C1 conditions and
-cubic reproduction (least-norm solution of one linear system; see ``docs/terrain-schemes.md``)."""
+cubic reproduction (least-norm solution of one linear system; see ``docs/terrain-schemes.md``). The scheme
+reads the solution stored in :mod:`splinevis.terrain._c1_weights` (``tools/gen_scheme_weights.py``); the
+derivation here is its proof."""
 
 from __future__ import annotations
 
@@ -90,8 +92,12 @@ def _c1_solution():
 
 @functools.lru_cache(maxsize=None)
 def _c1():
-    """The C1 scheme's weights on the 6x6 window ``[-2, 3]^2``."""
-    Wc, _ = _c1_solution()
+    """The C1 scheme's weights on the 6x6 window ``[-2, 3]^2``, read from the stored solution
+    :mod:`splinevis.terrain._c1_weights` (no solve at run time; written by ``tools/gen_scheme_weights.py`` from
+    :func:`_c1_solution`, which tests/test_scheme_weights.py re-runs and compares bit for bit)."""
+    from ._c1_weights import C1_FLOATS
+
+    Wc = np.array(C1_FLOATS, dtype=np.float64)
     offs = _offsets(-2, -2, 6, 6)
     W = np.zeros((36, 30))
     for s, o in enumerate(C1_STENCIL):

@@ -3,7 +3,8 @@
 Each is a :class:`~splinevis.gl.contract.HardCase` that the tests and the self-test render and compare per
 pixel (:func:`splinevis.analysis.agreement.depth_agreement`): grazing rays, rays along grid lines and through
 vertices, the underside, a camera inside the bounding box, UTM-sized coordinates, extreme zoom, flat and almost
-flat data, and a grid wider than a texture row. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
+flat data, a grid wider than a texture row, and high-relief terrain (crater walls, a cliff of 150 cells)
+in every scheme at overview, oblique and close-up views. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
 """
 
 from __future__ import annotations
@@ -76,6 +77,50 @@ def _wide():
     return TerrainSpline.from_heights(z, "C2", spacing=(1.0, 1.0))
 
 
+def high_relief(kind: str, n: int = 129) -> np.ndarray:
+    """Heights of high-relief test terrain on n x n unit cells: ``"crater"``, a volcano with a crater (walls
+    about 120 cells high over 35 cells, a rim, sample noise) or ``"cliff"``, a plateau 150 cells high behind
+    a wall one cell wide (slope 89.6 degrees) that curves across the grid.
+
+    >>> z = high_relief("cliff", 33)
+    >>> z.shape, float(z.max() - z.min()) > 149
+    ((33, 33), True)
+    """
+    y, x = np.mgrid[0:n, 0:n].astype(float)
+    c = (n - 1) / 2
+    if kind == "crater":
+        r = np.hypot(x - c, y - c) / c
+        rim = 0.45
+        cone = 120.0 * np.clip(1 - (r - rim) / (1 - rim), 0, 1) ** 1.5
+        inner = 108.0 * np.clip(r / rim, 0, 1) ** 8 + 12.0
+        return np.where(r < rim, inner, cone) + np.random.default_rng(0).normal(scale=0.5, size=x.shape)
+    if kind == "cliff":
+        edge = c + 0.25 * c * np.sin(3.0 * y / n)  # the wall's x position varies with y
+        return 150.0 * np.clip(x - edge + 0.5, 0.0, 1.0)
+    raise ValueError(f"kind must be 'crater' or 'cliff', got {kind!r}.")
+
+
+@functools.lru_cache(maxsize=12)
+def _relief(kind: str, scheme: str) -> TerrainSpline:
+    return TerrainSpline.from_heights(high_relief(kind), scheme, spacing=(1.0, 1.0))
+
+
+def _steep_fractal():
+    # 2049^2 fractal heights 0..2000 cells high: median slope 77 degrees, 99th percentile 85 (about 1 GB of
+    # coefficients; users saw 50-73 pinholes per frame on such a grid before the rebasing in terrain.glsl)
+    from datasets_synthetic.dem_files import fractal_terrain
+
+    return TerrainSpline.from_heights(fractal_terrain(2049, seed=5, amplitude=2000.0), "C2", spacing=(1.0, 1.0))
+
+
+#: Overview (the whole crater from afar), oblique (down a wall) and close-up (along a wall's foot) views.
+RELIEF_VIEWS = {
+    "overview": [(-60.0, -90.0, 260.0), (64.0, 64.0, 40.0), (0, 0, 1)],
+    "oblique": [(-20.0, 10.0, 90.0), (64.0, 64.0, 60.0), (0, 0, 1)],
+    "close-up": [(40.0, 52.0, 30.0), (64.0, 64.0, 20.0), (0, 0, 1)],
+}
+
+
 def hard_cases() -> list:
     """The terrain's hard cases (module docstring), 400 x 300 pixels each.
 
@@ -83,7 +128,7 @@ def hard_cases() -> list:
     --------
     >>> cases = hard_cases()
     >>> len(cases), cases[0].name, cases[0].window_size, cases[5].clipping_range
-    (11, 'oblique', (400, 300), (0.001, 5.0))
+    (42, 'oblique', (400, 300), (0.001, 5.0))
     """
     size = (400, 300)
     grazing_z = 1.25
@@ -104,4 +149,8 @@ def hard_cases() -> list:
         HardCase("almost-flat", functools.partial(_flat, True), flat_view, size, min_hits=0.05),
         HardCase("wider-than-a-texture-row", _wide, [(2290.0, -25.0, 70.0), (2330.0, 16.0, 15.0), (0, 0, 1)], size,
                  min_hits=0.05),
-    ]
+        HardCase("fractal-2048-steep", _steep_fractal, [(-600.0, -900.0, 4000.0), (1024.0, 1024.0, 900.0), (0, 0, 1)],
+                 size, min_hits=0.05),
+    ] + [HardCase(f"{kind}-{scheme}-{view}", functools.partial(_relief, kind, scheme), camera, size, min_hits=0.05)
+         for kind in ("crater", "cliff") for scheme in ("linear", "C0", "C1", "C2", "C2-cubic")
+         for view, camera in RELIEF_VIEWS.items()]

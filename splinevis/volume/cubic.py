@@ -10,6 +10,10 @@ distinct cubic domain points.
 
 Derivation (:func:`derive_weights`, float64 linear algebra, < 1 s, cached)
 --------------------------------------------------------------------------
+The package does not run it: it reads the result, exact multiples of 1/192, from
+:mod:`splinevis.volume._scheme_weights` (written by ``tools/gen_scheme_weights.py`` from this derivation and
+checked against it by tests/test_scheme_weights.py).
+
 1. Determining set D3 (56 points per cube, [Kalbe2008, sec. 5, Fig. 4]): the 8 cube vertices, the 24
    points at 1/3 and 2/3 of the 12 cube edges, and the 24 centroids of the boundary triangles
    ``[wF, u, u']``.
@@ -43,7 +47,7 @@ import numpy as np
 from ..bb import simplex as bb
 from .domain import domain_index, domain_table, inner_face_rows
 from .partition import NUM_TETS, _inner_faces as _inner_faces, _tets  # _inner_faces re-exported for the tests
-from .stencil import STENCIL, _apply_point_weights, _check_volume, _lift
+from .stencil import STENCIL, _apply_point_weights, _check_volume, _lift, _stored_weights
 
 __all__ = ["NUM_DOMAIN_POINTS", "domain_points", "determining_set", "inner_face_conditions", "derive_weights",
            "cubic_c1_spline"]
@@ -337,4 +341,4 @@ def cubic_c1_spline(volume) -> np.ndarray:
     >>> c.shape, bool(np.allclose(c, 2.0))
     ((3, 3, 3, 24, 20), True)
     """
-    return _apply_point_weights(_check_volume(volume), _weights()[0], _domain()[1])
+    return _apply_point_weights(_check_volume(volume), _stored_weights("cubic"), _domain()[1])

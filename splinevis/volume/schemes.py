@@ -25,8 +25,9 @@ Determining set and the remaining coefficients
 The 20 domain points on the cube's edges get data averages: a cube vertex (surrounded by 8 grid points)
 gets the mean of those 8 values, an edge midpoint the mean of the 4 grid values around the edge. Both are
 exact for linear ``f``.  The other 45 coefficients are fixed linear combinations of the cube's 27-point
-data stencil, derived once by :func:`derive_weights` (linear algebra, float64, then snapped to the exact
-multiples of 1/16 they turn out to be):
+data stencil, derived by :func:`derive_weights` (linear algebra, float64, then snapped to the exact
+multiples of 1/16 they turn out to be; the package reads them as exact fractions from
+:mod:`splinevis.volume._scheme_weights`, written by ``tools/gen_scheme_weights.py`` from this derivation):
 
 1. the 30 coefficients on the cube's boundary faces (``wF`` and ``(wF + u)/2``) from the C1 conditions
    of the face restriction on the criss-cross split of the face; the solution is unique and depends only
@@ -62,6 +63,7 @@ from .stencil import (
     _check_volume as _check_volume,
     _lift,
     _pad as _pad,
+    _stored_weights,
     pad_volume,
 )
 
@@ -174,7 +176,7 @@ def _edge_data_weights():
 
 def _snap(w):
     """The derived weights are multiples of 1/16: remove the solvers' rounding noise (only if tiny)."""
-    s = np.round(w * 2.0**10) / 2.0**10
+    s = np.round(w * 2.0**10) / 2.0**10 + 0.0  # no negative zeros
     return s if np.abs(s - w).max() < 1e-9 else w
 
 
@@ -323,8 +325,8 @@ def _check_scheme(scheme):
 def _point_weights(scheme):
     """(number of domain points, 27) weights and the (24, m) tetrahedron map of a scheme."""
     if scheme == "quadratic":
-        return _weights()[0], _domain()[1]
-    return _cubic._weights()[0], _cubic._domain()[1]
+        return _stored_weights("quadratic"), _domain()[1]
+    return _stored_weights("cubic"), _cubic._domain()[1]
 
 
 @functools.lru_cache(maxsize=None)

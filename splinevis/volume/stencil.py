@@ -7,6 +7,8 @@ of linear extrapolation (``f[-1] = 2 f[0] - f[1]``) beyond the boundary.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .._validation import as_float64_array
@@ -89,3 +91,21 @@ def _apply_point_weights(vol, W, tmap):
     """BB coefficients ``(nz, ny, nx, 24, m)`` of every cube of ``vol`` (checked) from the domain-point
     weights ``W`` (number of domain points, 27) and the tetrahedron map ``tmap`` (24, m)."""
     return (_stencil_data(vol) @ W.T)[..., tmap]
+
+
+@functools.lru_cache(maxsize=None)
+def _stored_weights(scheme):
+    """(number of domain points, 27) weights of ``scheme`` ("quadratic" or "cubic"), read from the exact
+    fractions stored in :mod:`splinevis.volume._scheme_weights`: no linear algebra at run time. Read-only; bit
+    for bit the result of the scheme's ``derive_weights`` (checked by tests/test_scheme_weights.py)."""
+    from . import _scheme_weights as stored
+
+    start = 0
+    for name, (shape, den) in stored.TABLES.items():
+        if name == scheme:
+            num = np.array(stored.NUMERATORS.split(), dtype=np.int64)[start:start + shape[0] * shape[1]]
+            W = num.reshape(shape).astype(np.float64) / den  # correctly rounded: float64(n / den)
+            W.setflags(write=False)
+            return W
+        start += shape[0] * shape[1]
+    raise ValueError(f"no stored weights for the volume scheme {scheme!r}.")
