@@ -11,6 +11,8 @@ Cases
 * ``volume``: isosurface of Marschner-Lobb 64^3 in a full view and a close-up: spline programs (quadratic /
   cubic, block / cube proxies, data / coefficient encoding, culling on / off) side by side with a flying-edges
   marching cubes mesh and VTK's GPU isosurface ray caster of the same data.
+* ``large_terrain``: a 3601 x 3601 terrain (an SRTM tile): construction s, program + first frame s, frame ms,
+  peak MB (own process); ``cold_start``: seconds from a new process to the models and the first picture.
 * ``terrain``: the terrain ray caster on 65x65 .. 1025x1025 grids in one full-screen view, with the
   min/max hierarchy on and off (the hierarchical equivalent of the front-to-back occlusion sets of [Reis2008, sec. VII]).
 
@@ -189,20 +191,34 @@ def bench_volume(repeats, quick):
 
 def _markdown(results):
     lines = [f"# splinevis benchmarks\n\n{results['machine']}\n"]
-    lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
-    lines.append("| renderer | triangles | min ms | median ms | median / ray-cast |")
-    lines.append("|---|---:|---:|---:|---:|")
-    for r in results["raycast_vs_mesh"]:
+    if "raycast_vs_mesh" in results:
+        lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
+        lines.append("| renderer | triangles | min ms | median ms | median / ray-cast |")
+        lines.append("|---|---:|---:|---:|---:|")
+    for r in results.get("raycast_vs_mesh", []):
         lines.append(f"| {r['renderer']} | {r['triangles']:,} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_raycast']:.2f} |")
-    lines.append("\n## Effect sets on the ray-cast patch\n")
-    lines.append("| effect set | compiled effects | min ms | median ms | median / unlit |")
-    lines.append("|---|---|---:|---:|---:|")
-    for r in results["effect_sets"]:
+    if "effect_sets" in results:
+        lines.append("\n## Effect sets on the ray-cast patch\n")
+        lines.append("| effect set | compiled effects | min ms | median ms | median / unlit |")
+        lines.append("|---|---|---:|---:|---:|")
+    for r in results.get("effect_sets", []):
         lines.append(f"| {r['effect_set']} | {', '.join(r['effects']) or '-'} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_unlit']:.2f} |")
-    lines.append("\n## Terrain ray casting: grid size and hierarchy (same full-screen oblique view)\n")
-    lines.append("| grid | patches | hierarchy | screen covered | min ms | median ms | median / 65x65 |")
-    lines.append("|---|---:|---|---:|---:|---:|---:|")
-    for r in results["terrain"]:
+    for r in results.get("large_terrain", []):
+        lines.append("\n## Large terrain (own process)\n")
+        lines.append("| grid | patches | construction s | program + first frame s | frame median ms | covered | peak MB |")
+        lines.append("|---|---:|---:|---:|---:|---:|---:|")
+        lines.append(f"| {r['grid']} | {r['patches']:,} | {r['construction_s']:.1f} | {r['program_and_first_frame_s']:.1f} | "
+                     f"{r['frame_median_ms']:.0f} | {r['screen_covered']:.2f} | {r['peak_MB']:.0f} |")
+    for r in results.get("cold_start", []):
+        lines.append("\n## Cold start (new process, median)\n")
+        lines.append("| import s | C1 terrain 65^2 + quadratic and cubic volume 16^3 s | first terrain picture s |")
+        lines.append("|---:|---:|---:|")
+        lines.append(f"| {r['import_s']:.2f} | {r['models_s']:.2f} | {r['first_picture_s']:.2f} |")
+    if "terrain" in results:
+        lines.append("\n## Terrain ray casting: grid size and hierarchy (same full-screen oblique view)\n")
+        lines.append("| grid | patches | hierarchy | screen covered | min ms | median ms | median / 65x65 |")
+        lines.append("|---|---:|---|---:|---:|---:|---:|")
+    for r in results.get("terrain", []):
         lines.append(f"| {r['grid']} | {r['patches']:,} | {'min/max quadtree' if r['hierarchy'] else 'off (cell walk)'} | "
                      f"{r['screen_covered']:.2f} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_smallest_grid']:.2f} |")
     if "volume" in results:
@@ -219,6 +235,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--quick", action="store_true", help="fewer configurations (smoke run)")
+    ap.add_argument("--cases", nargs="+", default=None, help="run only these cases (default: all)")
     args = ap.parse_args(argv)
     from tqdm import tqdm
 
@@ -227,8 +244,16 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    from bench_scale import bench_cold_start, bench_large_terrain
+
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
-             ("volume", bench_volume)]
+             ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start)]
+    known = [name for name, _ in cases]
+    if args.cases:
+        unknown = sorted(set(args.cases) - set(known))
+        if unknown:
+            ap.error(f"unknown case(s) {', '.join(unknown)}; known: {', '.join(known)}")
+        cases = [c for c in cases if c[0] in args.cases]
     for name, fn in tqdm(cases, desc="benchmarks"):
         results[name] = fn(args.repeats, args.quick)
     out = Path(args.out)

@@ -1,5 +1,6 @@
 """Writers of volume files for the reader tests and examples: a VolumeGrid to .vti/.vtk/.mha/.mhd/.nrrd/.nhdr/
-.raw/.slc with a chosen dtype, byte order and axis direction, so every reader is checked against a file whose
+.raw/.slc (:func:`write_volume`), a Gaussian cube file (:func:`write_cube`) or a folder of raw slices
+(:func:`write_slices`) with a chosen dtype, byte order and axis direction, so every reader is checked against a file whose
 true sample positions are known."""
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import numpy as np
 
 from splinevis.io.volumes import VolumeGrid
 
-__all__ = ["WRITE_FORMATS", "write_volume"]
+__all__ = ["WRITE_FORMATS", "write_volume", "write_cube", "write_slices"]
 
 
 WRITE_FORMATS = (".vti", ".vtk", ".mha", ".mhd", ".nrrd", ".nhdr", ".raw", ".slc")
@@ -166,3 +167,46 @@ def write_volume(grid: VolumeGrid, path, *, dtype=None, byteorder="little", dire
     else:
         path.write_bytes(head.encode() + body)
     return {}
+
+
+def write_cube(grid: VolumeGrid, path, *, direction=None, atoms=((8, 0.0, 0.0, 0.0, 0.0),), per_line=6,
+               comments=("splinevis test cube", "synthetic field")) -> Path:
+    """Write ``grid`` as a Gaussian cube file (Bohr units: positive counts) on axes ``direction`` (columns;
+    default ``grid.direction``). Samples are written first axis slowest, third fastest, ``per_line`` a line,
+    with ``repr`` (exact round trip). ``atoms``: rows ``(Z, charge, x, y, z)``.
+
+    >>> import tempfile, numpy as np
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     p = write_cube(VolumeGrid(np.arange(8.0).reshape(2, 2, 2)), Path(folder) / "a.cube")
+    ...     print(p.read_text().splitlines()[3])
+    2 1.0 0.0 0.0
+    """
+    path = Path(path)
+    D = np.asarray(grid.direction if direction is None else direction, dtype=np.float64).reshape(3, 3)
+    nz, ny, nx = grid.shape
+    lines = list(comments)
+    lines.append(f"{len(atoms)} " + " ".join(map(_num, grid.origin)))
+    for n, a in zip((nx, ny, nz), range(3)):
+        lines.append(f"{n} " + " ".join(map(_num, D[:, a] * grid.spacing[a])))
+    for atom in atoms:
+        lines.append(f"{int(atom[0])} " + " ".join(map(_num, atom[1:])))
+    data = np.transpose(grid.values, (2, 1, 0)).ravel()  # [k, j, i] -> [i, j, k], k fastest
+    for start in range(0, data.size, per_line):
+        lines.append(" ".join(map(_num, data[start:start + per_line])))
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def write_slices(grid: VolumeGrid, folder, *, dtype="uint16", byteorder="little", pattern="slice{}.raw",
+                 header_bytes=0) -> list:
+    """Write each z slice of ``grid`` to ``folder/pattern.format(k)`` (headerless, x fastest), with an
+    optional header of ``header_bytes`` zero bytes. Returns the paths (slice order)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    dt = np.dtype(dtype).newbyteorder("<" if byteorder == "little" else ">")
+    out = []
+    for k in range(grid.shape[0]):
+        p = folder / pattern.format(k)
+        p.write_bytes(b"\0" * header_bytes + grid.values[k].astype(dt).tobytes())
+        out.append(p)
+    return out

@@ -137,6 +137,12 @@ def main(argv=None) -> int:
     except (ValueError, TypeError) as exc:
         print(f"splinevis: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # --out a file, below a file, unwritable, disk full: one line, no traceback
+        where = exc.filename or getattr(args, "out", None)
+        reason = exc.strerror or type(exc).__name__
+        print(f"splinevis: cannot write to {where} ({reason}); --out must be a writable directory "
+              f"(given: --out {getattr(args, 'out', None)}). Pick another path.", file=sys.stderr)
+        return 4
 
 
 if __name__ == "__main__":

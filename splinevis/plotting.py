@@ -39,6 +39,42 @@ def _style_from(style, style_kwargs) -> Style:
     return style.replace(**style_kwargs) if style_kwargs else style
 
 
+#: Largest |height| (and height span) the terrain program accepts: the GPU computes in float32, whose
+#: largest finite number is 3.4e38; heights are shifted and their differences scaled on the GPU, so the
+#: limit keeps a margin of 1e6 below it.
+HEIGHT_LIMIT = float(np.finfo(np.float32).max) / 1e6
+
+
+def _check_window_size(window_size) -> None:
+    """ValueError unless ``window_size`` is two positive ints ``(width, height)``.
+
+    >>> _check_window_size((0, 0))
+    Traceback (most recent call last):
+    ValueError: window_size=(0, 0) must be two positive pixel counts (width, height), e.g. window_size=(800, 600); a zero or negative size would silently render a 300 x 300 picture.
+    """
+    try:
+        w, h = window_size
+        ok = all(not isinstance(v, bool) and int(v) == v and int(v) > 0 for v in (w, h))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"window_size={window_size!r} must be two positive pixel counts (width, height), e.g. "
+                         "window_size=(800, 600); a zero or negative size would silently render a 300 x 300 "
+                         "picture.")
+
+
+def _check_heights_fit_float32(grid) -> None:
+    """ValueError when heights exceed :data:`HEIGHT_LIMIT` (the GPU's float32 would overflow: blank image)."""
+    v = np.asarray(grid.heights, dtype=np.float64)
+    top = float(np.abs(v).max())
+    span = float(v.max() - v.min())
+    if top > HEIGHT_LIMIT or span > HEIGHT_LIMIT:
+        raise ValueError(f"heights: the largest |height| is {top:.6g} (span {span:.6g}), beyond the limit "
+                         f"{HEIGHT_LIMIT:.3g} the GPU program can take (it computes in float32, max 3.4e38; "
+                         "the limit keeps a margin for its arithmetic), so the picture would be blank. Rescale "
+                         "the heights (e.g. heights / 1e300, or other units) before add_terrain.")
+
+
 class Plotter(pv.Plotter):
     """A :class:`pyvista.Plotter` with :meth:`add_spline`; everything else is PyVista's.
 
@@ -62,12 +98,19 @@ class Plotter(pv.Plotter):
     _spline_actors: tuple = ()
 
     def __init__(self, *args, anti_aliasing: bool = False, **kwargs):
+        if kwargs.get("window_size") is not None:
+            _check_window_size(kwargs["window_size"])
         super().__init__(*args, **kwargs)
         if not anti_aliasing:
             self.disable_anti_aliasing()
             self.render_window.SetMultiSamples(0)  # before the first render: single-sample buffers
         self._spline_actors: list[SplineActor] = []
         self._gl_checked = False
+
+    def __del__(self):
+        if "_initialized" not in self.__dict__:  # __init__ refused its arguments before pyvista set up
+            return
+        super().__del__()
 
     def add_spline(self, model, style: Style | None = None, *, name: str | None = None,
                    newton_iterations: int | None = None, program_options: dict | None = None,
@@ -148,6 +191,14 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
+        from .io import read_heights
+        from .programs import get
+
+        if not isinstance(heights, get("terrain").model_type) and not hasattr(heights, "crs"):
+            heights = read_heights(heights, **(read_options or {}))  # raw data: read here to check the range
+            read_options = None
+        if hasattr(heights, "crs"):  # a HeightGrid (duck-typed: plotting names no family types)
+            _check_heights_fit_float32(heights)
         return self._add_from("terrain", (heights, scheme, presmooth), read_options, style, options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
@@ -160,7 +211,9 @@ class Plotter(pv.Plotter):
         file); ``scheme`` ``"quadratic"`` or ``"cubic"`` (ignored for a VolumeSpline). ``culling``: hierarchical
         view-frustum culling of the proxies by the octree before every frame (``actor.culler``). Program options
         (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
-        :meth:`add_spline`). An isovalue outside the data's range draws nothing. Returns the
+        :meth:`add_spline`). An isovalue outside the data's range (an empty isosurface) raises ValueError
+        giving the range. A volume on a rotated orthogonal lattice (``VolumeGrid.direction``, e.g. a Gaussian
+        cube file) is drawn in its true frame (the actor's user matrix; no culling then). Returns the
         :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.isosurface.Isosurface`.
 
         Examples

@@ -212,20 +212,43 @@ def test_axis_flips_are_normalised_to_the_same_picture(tmp_path, ext):
 
 
 @pytest.mark.parametrize("ext", [".vti", ".mha", ".nrrd", None])
-def test_rotated_or_permuted_direction_is_refused(tmp_path, ext):
+def test_rotated_or_permuted_direction_round_trips_and_shear_is_refused(tmp_path, ext):
     c, s = np.cos(0.3), np.sin(0.3)
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
     perm = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
-    for D, what in ((rot, r"is not axis-aligned \(a rotation or shear\)"), (perm, "permutes the axes")):
-        g = VolumeGrid(np.zeros((3, 3, 3)))
+    shear = np.array([[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    a = values_of("int16", (3, 4, 5))
+    spacing, origin = (0.5, 2.0, 3.0), (10.0, 20.0, 30.0)
+    for n, D in enumerate((rot, perm, shear)):
+        g = VolumeGrid(a, spacing=spacing, origin=origin, dtype="int16")
         if ext is None:
             src = g.to_pyvista()
             src.direction_matrix = D
         else:
-            src = tmp_path / f"r{ext}"
+            src = tmp_path / f"r{n}{ext}"
             write_volume(g, src, direction=D)
-        with pytest.raises(ValueError, match=what + r"; only axis-aligned grids \(the identity up to axis flips"):
-            read_volume(src)
+        if D is shear:
+            with pytest.raises(ValueError, match=r"is not orthonormal \(a shear or non-orthogonal axes"):
+                read_volume(src)
+            continue
+        r = read_volume(src)
+        assert np.allclose(r.direction, D, atol=1e-12) and r.is_rotated
+        assert np.allclose(r.spacing, spacing, rtol=1e-12) and np.allclose(r.origin, origin, rtol=1e-12)
+        assert np.array_equal(r.values, a)
+        # the world position of every sample is VTK's: origin + D @ (i dx, j dy, k dz)
+        img = pv.ImageData(dimensions=(5, 4, 3), spacing=spacing, origin=origin)
+        img.direction_matrix = D
+        lattice = np.stack(np.meshgrid(*r.axes(), indexing="ij"), axis=-1).transpose(2, 1, 0, 3)
+        assert np.allclose(r.lattice_to_world(lattice), img.points.reshape(3, 4, 5, 3), atol=1e-9)
+
+
+def test_volume_grid_direction_default_and_validation():
+    g = VolumeGrid(np.zeros((2, 2, 2)))
+    assert g.direction == ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)) and not g.is_rotated
+    with pytest.raises(ValueError, match="VolumeGrid direction: the direction matrix .* is not orthonormal"):
+        VolumeGrid(np.zeros((2, 2, 2)), direction=2 * np.eye(3))
+    with pytest.raises(ValueError, match="not a finite 3 x 3 matrix"):
+        VolumeGrid(np.zeros((2, 2, 2)), direction=np.eye(2))
 
 
 def test_nrrd_tiny_axis_vector_of_few_samples_is_not_taken_for_components(tmp_path):
@@ -395,7 +418,7 @@ def test_missing_empty_unsupported_and_corrupt_files_name_the_path(tmp_path):
         read_volume(tmp_path / "x.xyz")
     with pytest.raises(ValueError, match=r"NIfTI files are not read .* convert to NRRD"):
         read_volume(tmp_path / "brain.nii")
-    with pytest.raises(ValueError, match="is a directory; DICOM series are not read"):
+    with pytest.raises(ValueError, match="stack of headerless raw slices and needs shape= and dtype=.*DICOM series are not read"):
         read_volume(tmp_path)
     # MetaImage whose data are cut short: VTK only warns and returns garbage; we raise
     g = grid_of("int16")
@@ -424,3 +447,99 @@ def test_volumegrid_rescale_field_and_axes():
     assert x.tolist() == [1.0, 1.5, 2.0] and z.tolist() == [0.0, 2.0]
     with pytest.raises(ValueError, match="rescale must be"):
         VolumeGrid(np.zeros((2, 2, 2)), rescale=(0.0, 1.0))
+
+
+# ---- Gaussian cube files (rotated orthogonal lattices) --------------------------------------------------
+def _rotation(a=0.4, b=-0.7, c=1.1):
+    def rx(t):
+        return np.array([[1, 0, 0], [0, np.cos(t), -np.sin(t)], [0, np.sin(t), np.cos(t)]])
+
+    def rz(t):
+        return np.array([[np.cos(t), -np.sin(t), 0], [np.sin(t), np.cos(t), 0], [0, 0, 1]])
+    return rz(a) @ rx(b) @ rz(c)
+
+
+def test_cube_file_round_trips_values_spacing_origin_and_direction(tmp_path):
+    from datasets_synthetic.volume_files import write_cube
+
+    R = _rotation()
+    a = values_of("float64", (3, 4, 5))
+    g = VolumeGrid(a, spacing=(0.2, 0.3, 0.25), origin=(-1.5, 2.0, 0.125), direction=R)
+    r = read_volume(write_cube(g, tmp_path / "orb.cube", atoms=((8, 0, 0, 0, 0), (1, 0, 1.4, 0, 0))))
+    assert np.array_equal(r.values, a) and r.shape == (3, 4, 5)
+    assert np.allclose(r.spacing, g.spacing, rtol=1e-14) and r.origin == g.origin
+    assert np.allclose(r.direction, R, atol=1e-14) and r.is_rotated
+    # sample [k, j, i] lies at origin + R @ (i dx, j dy, k dz)
+    assert np.allclose(r.lattice_to_world(r.to_world([4, 3, 2])), g.origin + R @ (np.array([4, 3, 2]) * g.spacing))
+    assert "Gaussian cube" in volumes_module.VOLUME_EXTENSIONS[".cube"]
+
+
+def test_cube_file_negative_natoms_orbital_line_and_several_values(tmp_path):
+    a = values_of("float64", (2, 2, 3))
+    data = np.transpose(a, (2, 1, 0)).ravel()
+    two = np.column_stack([data, -data]).ravel()
+    text = ("c\nc\n-1 0.0 0.0 0.0 2\n3 1.0 0.0 0.0\n2 0.0 1.0 0.0\n2 0.0 0.0 1.0\n6 0.0 0.0 0.0 0.0\n2 7 8\n"
+            + "\n".join(" ".join(repr(float(v)) for v in two[i:i + 5]) for i in range(0, two.size, 5)) + "\n")
+    (tmp_path / "mo.cube").write_text(text)
+    with pytest.raises(ValueError, match=r"2 components per sample.*component=0\.\.1"):
+        read_volume(tmp_path / "mo.cube")
+    assert np.array_equal(read_volume(tmp_path / "mo.cube", component=1).values, -a)
+    assert not read_volume(tmp_path / "mo.cube", component=0).is_rotated
+
+
+def test_cube_file_errors_name_the_file_and_the_fix(tmp_path):
+    from datasets_synthetic.volume_files import write_cube
+
+    g = VolumeGrid(values_of("float64", (3, 3, 3)))
+    p = write_cube(g, tmp_path / "t.cube")
+    lines = p.read_text().splitlines()
+    (tmp_path / "short.cube").write_text("\n".join(lines[:-1]) + "\n")
+    with pytest.raises(ValueError, match=r"short\.cube: expected 27 samples .* holds 2[0-9]; the file is truncated"):
+        read_volume(tmp_path / "short.cube")
+    (tmp_path / "head.cube").write_text("\n".join(lines[:4]) + "\n")
+    with pytest.raises(ValueError, match=r"head\.cube: a Gaussian cube file needs at least 6 header lines"):
+        read_volume(tmp_path / "head.cube")
+    sheared = lines[:4] + ["3 0.5 1.0 0.0"] + lines[5:]
+    (tmp_path / "shear.cube").write_text("\n".join(sheared) + "\n")
+    with pytest.raises(ValueError, match=r"shear\.cube: the direction matrix .* is not orthonormal"):
+        read_volume(tmp_path / "shear.cube")
+    with pytest.raises(ValueError, match="spacing= and origin=|carry|own geometry|spacing"):
+        read_volume(p, spacing=(1, 1, 1))
+
+
+# ---- stacks of raw slices -------------------------------------------------------------------------------
+def test_folder_and_glob_of_raw_slices_read_as_one_volume_in_natural_order(tmp_path):
+    from datasets_synthetic.volume_files import write_slices
+
+    a = values_of("uint16", (12, 3, 4))
+    g = VolumeGrid(a, dtype="uint16")
+    write_slices(g, tmp_path / "ct", dtype="uint16", byteorder="big")  # slice0 ... slice11: natural order
+    (tmp_path / "ct" / ".DS_Store").write_bytes(b"x")  # hidden files are skipped
+    r = read_volume(tmp_path / "ct", shape=(3, 4), dtype="uint16", byteorder="big", spacing=(0.5, 0.5, 2.0))
+    assert np.array_equal(r.values, a) and r.spacing == (0.5, 0.5, 2.0) and r.dtype == "uint16"
+    r2 = read_volume(str(tmp_path / "ct" / "slice*.raw"), shape=(12, 3, 4), dtype=">u2")
+    assert np.array_equal(r2.values, a)
+    write_slices(g, tmp_path / "hdr", dtype="uint16", header_bytes=16)
+    assert np.array_equal(read_volume(tmp_path / "hdr", shape=(3, 4), dtype="uint16", byteorder="little",
+                                      header_bytes=16).values, a)
+
+
+def test_slice_stack_errors_are_clear(tmp_path):
+    from datasets_synthetic.volume_files import write_slices
+
+    g = VolumeGrid(values_of("uint8", (3, 3, 4)), dtype="uint8")
+    write_slices(g, tmp_path / "s", dtype="uint8")
+    with pytest.raises(ValueError, match=r"stack of headerless raw slices and needs shape= and dtype="):
+        read_volume(tmp_path / "s")
+    (tmp_path / "s" / "slice1.raw").write_bytes(b"\0" * 10)
+    with pytest.raises(ValueError, match=r"slice1\.raw: slice 1 has 10 bytes, expected 12 .*check shape=\(ny, nx\)"):
+        read_volume(tmp_path / "s", shape=(3, 4), dtype="uint8")
+    with pytest.raises(ValueError, match=r"shape \(5, 3, 4\) says 5 slices, found 3 files"):
+        read_volume(tmp_path / "s", shape=(5, 3, 4), dtype="uint8")
+    with pytest.raises(FileNotFoundError, match=r"no file matches the slice pattern"):
+        read_volume(str(tmp_path / "s" / "nothing*.raw"), shape=(3, 4), dtype="uint8")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match=r"empty folder"):
+        read_volume(tmp_path / "empty", shape=(3, 4), dtype="uint8")
+    with pytest.raises(ValueError, match=r"uint16 samples take 2 bytes; pass byteorder="):
+        read_volume(tmp_path / "s", shape=(3, 4), dtype="uint16")

@@ -89,3 +89,28 @@ def test_paper_root_finder_is_selectable_and_compiled_in_only_on_request(franke_
     assert "return sv_first_root_bracketed(c, n, iterations);" in sources["bracketed"]
     assert "return sv_first_root_newton4(c, n, iterations);" in sources["paper"]
     assert "return sv_first_root_newton4(c, n, iterations);" not in sources["bracketed"]
+
+
+def test_coefficient_table_split_into_textures_gives_the_same_image():
+    # tables over 1 GiB are split by rows into up to 4 textures (llvmpipe reads zeros from larger ones); a
+    # small table split on purpose (rows_per_texture) must draw exactly the picture of the unsplit one
+    from datasets_synthetic.dem_files import fractal_terrain
+
+    import splinevis
+
+    z = np.tile(fractal_terrain(129, seed=3, amplitude=20.0)[:17], (1, 17))[:, :2049]  # 2048 x 16 cells: 32 rows
+    t = TerrainSpline.from_heights(z, "C1", spacing=(1.0, 1.0))
+    images = {}
+    for rows in (8192, 16, 11, 8):  # 1, 2, 3, 4 textures
+        pl = splinevis.Plotter(off_screen=True, window_size=(240, 180))
+        a = pl.add_spline(t, lights=1, program_options={"rows_per_texture": rows})
+        pl.camera_position = [(900.0, -30.0, 80.0), (1200.0, 8.0, 5.0), (0, 0, 1)]
+        pl.reset_camera_clipping_range()
+        images[rows] = pl.screenshot().astype(int)
+        n_tex = sum(name.startswith("sv_terrain_coef") for name in a.spec.textures)
+        pl.close()
+        assert n_tex == {8192: 1, 16: 2, 11: 3, 8: 4}[rows]
+    assert (images[8192].sum(-1) < 700).mean() > 0.05  # the strip is drawn
+    assert all(np.array_equal(images[8192], im) for im in images.values())
+    with pytest.raises(ValueError, match="needs 8 textures of 1024 MB.*at most 4"):
+        TerrainSpline.from_heights(np.zeros((8001, 8001)), "linear")  # refused before 15 GB of coefficients

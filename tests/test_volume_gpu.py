@@ -53,7 +53,40 @@ def test_paper_newton_errors_are_misses_or_later_roots_never_phantoms():
     assert wrong.mean() + (ref_hit & ~gpu_hit).sum() / ref_hit.sum() <= 0.05
 
 
+def test_isovalue_outside_the_data_raises_with_the_range_in_add_isosurface_and_set_isovalue():
+    from splinevis.volume.program import set_isovalue
+
+    lo, hi = VolumeSpline(sphere_grid()).value_range
+    pl = splinevis.Plotter(off_screen=True, window_size=(80, 60))
+    for iso_value in (5.0, -1.0):
+        with pytest.raises(ValueError, match=rf"isovalue={iso_value!r} lies outside the volume's data range "
+                                             rf"\[{lo!r}, {hi!r}\].*Pass an isovalue inside that range"):
+            pl.add_isosurface(sphere_grid(), iso_value)
+    actor = pl.add_isosurface(sphere_grid(), 0.7)
+    with pytest.raises(ValueError, match=r"isovalue=5\.0 lies outside"):
+        set_isovalue(actor, 5.0)
+    assert actor.model.isovalue == 0.7  # the actor keeps its isosurface
+    pl.close()
+
+
+def test_set_isovalue_replaces_textures_without_a_vtk_warning():
+    from splinevis.gl.inject import capture_vtk_errors
+    from splinevis.volume.program import set_isovalue
+
+    for program_options in (None, {"encoding": "coefficients"}):
+        pl = splinevis.Plotter(off_screen=True, window_size=(64, 48))
+        with capture_vtk_errors() as captured:
+            actor = pl.add_isosurface(sphere_grid(12), 0.7, program_options=program_options)
+            pl.screenshot()
+            for iso in (0.4, 0.9):
+                set_isovalue(actor, iso)  # replaces sv_volume_mask (and the coefficient table)
+                pl.render()
+        pl.close()
+        assert "warn" not in captured.text.lower() and "error" not in captured.text.lower(), captured.text
+
+
 def test_isovalue_outside_the_data_is_an_empty_scene():
+    # an Isosurface built directly (not through add_isosurface) may be empty: add_spline draws nothing
     s = VolumeSpline(sphere_grid())
     for iso_value in (5.0, -1.0):
         iso = Isosurface(s, iso_value)

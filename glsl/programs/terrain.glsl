@@ -17,8 +17,8 @@
 // sv_terrain_coef (8 texels per cell, cells row after row: T0's 15 then T1's 15 coefficients, 2 zeros) and
 // sv_terrain_minmax (the hierarchy, level after level: level L's block (bi, bj) at texel
 // sv_level_offset[L] + bj * sv_level_width[L] + bi, .rg = (min, max)).
-uniform float sv_level_offset[16];
-uniform float sv_level_width[16];
+uniform int sv_level_offset[16];   // ints: offsets pass 2^24 texels on a 3600^2 grid, where floats skip
+uniform int sv_level_width[16];    // odd values (a block's bounds read from its neighbour: lines of pinholes)
 uniform int sv_top_level;
 uniform vec2 sv_ncells;            // (ncx, ncy)
 uniform vec2 sv_index_scale;       // u = sv_index_scale.x * x_mc + sv_index_shift.x (likewise v)
@@ -29,7 +29,26 @@ uniform int sv_newton_iterations;
 uniform float sv_scalar_offset;    // reference height: hit.scalar is the physical height (colormaps)
 
 vec2 sv_block_minmax(int level, ivec2 b) {
-    return sv_table_texel(sv_terrain_minmax, int(sv_level_offset[level]) + b.y * int(sv_level_width[level]) + b.x).rg;
+    return sv_table_texel(sv_terrain_minmax, sv_level_offset[level] + b.y * sv_level_width[level] + b.x).rg;
+}
+
+// A coefficient table over 1 GiB is split by rows into up to 4 textures (sv_terrain_coef, sv_terrain_coef1,
+// ...; SV_ROWS_PER_TEXTURE rows each): a cell's 8 texels share a row, so they share a texture.
+vec4 sv_coef_texel(ivec2 a) {
+#ifdef SV_TERRAIN_SPLIT
+    int piece = a.y / SV_ROWS_PER_TEXTURE;
+    ivec2 b = ivec2(a.x, a.y - piece * SV_ROWS_PER_TEXTURE);
+#ifdef SV_TERRAIN_SPLIT4
+    if (piece == 3) return texelFetch(sv_terrain_coef3, b, 0);
+#endif
+#ifdef SV_TERRAIN_SPLIT3
+    if (piece == 2) return texelFetch(sv_terrain_coef2, b, 0);
+#endif
+    if (piece == 1) return texelFetch(sv_terrain_coef1, b, 0);
+    return texelFetch(sv_terrain_coef, b, 0);
+#else
+    return texelFetch(sv_terrain_coef, a, 0);
+#endif
 }
 
 void sv_load_cell(ivec2 c, out float b0[15], out float b1[15]) {
@@ -37,7 +56,7 @@ void sv_load_cell(ivec2 c, out float b0[15], out float b1[15]) {
     // 8 texels per cell starting at a multiple of 8: one table row (lib/core/table.glsl)
     ivec2 first = sv_table_address(8 * (c.y * int(sv_ncells.x) + c.x));
     for (int q = 0; q < 8; ++q) {
-        vec4 v = texelFetch(sv_terrain_coef, first + ivec2(q, 0), 0);
+        vec4 v = sv_coef_texel(first + ivec2(q, 0));
         w[4 * q] = v.x; w[4 * q + 1] = v.y; w[4 * q + 2] = v.z; w[4 * q + 3] = v.w;
     }
     for (int q = 0; q < 15; ++q) {
@@ -64,11 +83,11 @@ const float SV_CELL_MARGIN = 1.52587890625e-05;
 // |lam_o| ~ that distance sums to 1 only within ~u times it, which scales the whole restricted polynomial:
 // on a flat plateau 90 m above the reference height that offset exceeded the slab and the ray missed
 // (pinholes on plateaus and valley floors). From a point in the cell the coordinates sum to 1 within a few u.
-float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb) {
+float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb, float margin) {
     vec3 start = o + ta * d;
     vec3 lo = sv_cell_bary(start.xy, tri);
     vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
-    float s = sv_graph_patch_hit(b, lo, ld, start.z, d.z, 0.0, tb - ta, SV_CELL_MARGIN, sv_newton_iterations);
+    float s = sv_graph_patch_hit(b, lo, ld, start.z, d.z, 0.0, tb - ta, margin, sv_newton_iterations);
     return s == SV_NO_HIT ? SV_NO_HIT : ta + s;
 }
 
@@ -132,9 +151,14 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             sv_load_cell(c, b0, b1);
             vec3 o = vec3(P0.xy - vec2(c), P0.z);
             // the cell's segment, widened by the margin (in t) on both ends
-            float dt_margin = SV_CELL_MARGIN / max(max(abs(D.x), abs(D.y)), 1e-30);
-            float h0 = sv_triangle_hit(b0, 0, o, D, t - dt_margin, tb + dt_margin);
-            float h1 = sv_triangle_hit(b1, 1, o, D, t - dt_margin, tb + dt_margin);
+            // The margin also covers the rounding of the ray's index coordinates P0 + t D (2 roundings on terms
+            // of size |P0.xy| and |t D.xy|, ~u times the grid's size): on a 3600^2 grid seen from afar that
+            // exceeds 2^-16 cells, and rays slipped between neighbouring cells and blocks (lines of pinholes).
+            float margin = max(SV_CELL_MARGIN, 4.76837158203125e-07 * (max(abs(P0.x), abs(P0.y))
+                                                                      + abs(t) * max(abs(D.x), abs(D.y))));
+            float dt_margin = margin / max(max(abs(D.x), abs(D.y)), 1e-30);
+            float h0 = sv_triangle_hit(b0, 0, o, D, t - dt_margin, tb + dt_margin, margin);
+            float h1 = sv_triangle_hit(b1, 1, o, D, t - dt_margin, tb + dt_margin, margin);
             float th = min(h0, h1);
             if (th < SV_NO_HIT) {
                 t_hit = th;

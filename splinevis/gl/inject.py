@@ -81,6 +81,12 @@ def _set_uniform(program, name: str, value) -> None:
     elif isinstance(value, (float, np.floating)):
         program.SetUniformf(name, float(value))
     else:
+        if np.asarray(value).dtype.kind in "iu" and name.endswith("[]"):  # int arrays stay exact (offsets > 2^24)
+            ints = np.asarray(value, dtype=np.int64).ravel()
+            if np.abs(ints).max(initial=0) >= 2**31:
+                raise ValueError(f"uniform {name}: values beyond the 32-bit int range.")
+            program.SetUniform1iv(name.rstrip("[]"), int(ints.size), [int(v) for v in ints])
+            return
         arr = np.asarray(value, dtype=np.float64)
         if arr.ndim == 1 and arr.size in (2, 3, 4) and not name.endswith("[]"):
             getattr(program, f"SetUniform{arr.size}f")(name, tuple(arr.tolist()))
@@ -253,6 +259,11 @@ class SplineActor:
         actor.SetMapper(mapper)
         self.offset = np.asarray(spec.offset, dtype=np.float64).reshape(3)
         actor.SetPosition(*self.offset.tolist())
+        self.actor = actor
+        self.rotation = None  # world-from-model rotation (None: the identity; see set_frame)
+        self.position = self.offset
+        if getattr(spec, "world_frame", None) is not None:  # (rotation, pivot) of a rotated lattice
+            self.set_frame(*spec.world_frame)
         prop = actor.GetProperty()
         if kind not in _FS_IMPL:
             raise ValueError(f"a SplineActor draws programs of kind {' or '.join(_FS_IMPL)}, not {kind!r}.")
@@ -390,6 +401,37 @@ class SplineActor:
 
     _on_update_shader.CallDataType = VTK_OBJECT
 
+    def set_frame(self, rotation, pivot) -> None:
+        """Draw the model rotated: world = ``pivot + rotation @ (p - pivot)`` for a model point ``p`` (the
+        model frame being the lattice of a rotated volume); ``rotation`` orthonormal (3, 3).
+
+        The actor gets the rigid motion as its user matrix (its position stays the offset); the ray cast keeps
+        working in the model frame (:meth:`camera_frame` maps the camera and lights into it) and the
+        window depth follows from VTK's ``MCDCMatrix``, which includes the user matrix.
+
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> actor = make_actor(patch_program(QuarticTrianglePatch.demo()))
+        >>> actor.set_frame([[0, -1, 0], [1, 0, 0], [0, 0, 1]], (1.0, 0.0, 0.0))
+        >>> actor.actor.GetMatrix().MultiplyPoint((2.0, 0.0, 0.0, 1.0))  # offset 0: model = world frame
+        (1.0, 1.0, 0.0, 1.0)
+        """
+        from vtkmodules.vtkCommonMath import vtkMatrix4x4
+
+        R = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
+        if np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
+            raise ValueError(f"set_frame needs an orthonormal rotation, got {R.tolist()}.")
+        pivot = np.asarray(pivot, dtype=np.float64).reshape(3)
+        self.rotation = R
+        self.position = pivot + R @ (self.offset - pivot)
+        shift = pivot - R @ pivot  # VTK applies the user matrix after the position (the offset)
+        m = vtkMatrix4x4()
+        for i in range(3):
+            for j in range(3):
+                m.SetElement(i, j, float(R[i, j]))
+            m.SetElement(i, 3, float(shift[i]))
+        self.actor.SetUserMatrix(m)
+
     def camera_frame(self):
         """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera.
 
@@ -417,6 +459,11 @@ class SplineActor:
         view /= np.linalg.norm(view)
         m = cam.GetViewTransformMatrix()
         rot = np.array([[m.GetElement(i, j) for j in range(3)] for i in range(3)])  # camera-from-world
+        if self.rotation is not None:  # a rotated model: camera and its frame into the model frame
+            R = self.rotation
+            eye = R.T @ (np.array(cam.GetPosition(), dtype=np.float64) - self.position)
+            view = R.T @ view
+            return eye, view / np.linalg.norm(view), bool(cam.GetParallelProjection()), R.T @ rot.T
         return eye, view, bool(cam.GetParallelProjection()), rot.T
 
     def _texture_map(self):

@@ -14,14 +14,19 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TEXTURE_WIDTH", "MAX_TEXTURE_ROWS", "BOX_CORNERS", "BOX_TRIANGLES", "boxes", "box_triangles",
-           "pack_rgba32f"]
+__all__ = ["TEXTURE_WIDTH", "MAX_TEXTURE_ROWS", "MAX_TEXTURE_BYTES", "ROWS_PER_TEXTURE", "BOX_CORNERS",
+           "BOX_TRIANGLES", "boxes", "box_triangles", "pack_rgba32f", "split_table"]
 
 #: Texels per row of every table (llvmpipe's and most GPUs' GL_MAX_TEXTURE_SIZE is 16384; 8192 keeps
 #: rows of moderate length for small tables). The GLSL constant SV_TABLE_WIDTH must equal it (tested).
 TEXTURE_WIDTH = 8192
 #: Rows a table may have (GL_MAX_TEXTURE_SIZE of llvmpipe and most GPUs).
 MAX_TEXTURE_ROWS = 16384
+#: Bytes one texture may hold: llvmpipe refuses larger textures (1 GiB) and the shader then reads zeros, with
+#: no error (a 3601^2 terrain drew contour lines only). Larger tables are split (:func:`split_table`).
+MAX_TEXTURE_BYTES = 1 << 30
+#: Rows of one texture of a split table (TEXTURE_WIDTH RGBA32F texels of 16 bytes per row).
+ROWS_PER_TEXTURE = MAX_TEXTURE_BYTES // (TEXTURE_WIDTH * 16)
 
 #: Unit-cube corners, x fastest then y then z.
 BOX_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
@@ -69,7 +74,20 @@ def box_triangles(n: int) -> np.ndarray:
     return (np.arange(n)[:, None, None] * 8 + BOX_TRIANGLES[None]).reshape(-1, 3)
 
 
-def pack_rgba32f(values, shift: float = 0.0, *, name: str = "table") -> np.ndarray:
+def split_table(table: np.ndarray, rows_per_texture: int = ROWS_PER_TEXTURE) -> list:
+    """The rows of a table texture in pieces of at most ``rows_per_texture`` rows (views, no copy): one texture
+    each, so that none exceeds :data:`MAX_TEXTURE_BYTES`. Row r of the table is row ``r % rows_per_texture`` of
+    piece ``r // rows_per_texture`` (``glsl/lib/core/table.glsl``).
+
+    >>> [p.shape[0] for p in split_table(np.zeros((5, 8192, 4), np.float32), 2)]
+    [2, 2, 1]
+    """
+    if rows_per_texture < 1:
+        raise ValueError(f"rows_per_texture must be >= 1, got {rows_per_texture}.")
+    return [table[r: r + rows_per_texture] for r in range(0, table.shape[0], rows_per_texture)]
+
+
+def pack_rgba32f(values, shift: float = 0.0, *, name: str = "table", split: bool = False) -> np.ndarray:
     """Pack ``values - shift`` (any shape, read flat) into a table texture, four floats per texel.
 
     The subtraction happens into the float32 buffer (no float64 temporary of the table's size); the tail
@@ -82,6 +100,9 @@ def pack_rgba32f(values, shift: float = 0.0, *, name: str = "table") -> np.ndarr
         Subtracted before rounding to float32 (e.g. a reference value that keeps float32 precision).
     name : str
         Named in the error when the table is too large.
+    split : bool
+        The caller splits the table into textures of at most :data:`MAX_TEXTURE_BYTES` (:func:`split_table`);
+        otherwise a table beyond that size is refused here, before the driver silently drops it.
 
     Returns
     -------
@@ -100,6 +121,10 @@ def pack_rgba32f(values, shift: float = 0.0, *, name: str = "table") -> np.ndarr
         raise ValueError(f"{name} needs {rows} rows of {TEXTURE_WIDTH} texels; at most {MAX_TEXTURE_ROWS} fit one "
                          f"texture ({len(flat)} floats > {4 * TEXTURE_WIDTH * MAX_TEXTURE_ROWS}). Split the data into "
                          "tiles or use a coarser level.")
+    if not split and rows * TEXTURE_WIDTH * 16 > MAX_TEXTURE_BYTES:
+        raise ValueError(f"{name} needs {rows * TEXTURE_WIDTH * 16 / 2**20:.0f} MB; one texture holds at most "
+                         f"{MAX_TEXTURE_BYTES / 2**20:.0f} MB on this OpenGL (larger ones read as zeros). Use a "
+                         "coarser grid or split the data.")
     buf = np.empty(rows * TEXTURE_WIDTH * 4, dtype=np.float32)
     np.subtract(flat, shift, out=buf[: len(flat)], casting="same_kind")
     buf[len(flat):] = 0

@@ -11,7 +11,8 @@ What is read:
 * 3 spatial axes, plus at most one component axis (kind ``vector``, ``RGB-color``, ..., or the fastest
   axis of a 4-D file without kinds), picked with ``component=``;
 * geometry from ``space origin``/``space directions``, used as given (coordinates of the file's
-  ``space``, e.g. LPS or RAS, are not converted); directions must be axis-aligned up to flips. Without
+  ``space``, e.g. LPS or RAS, are not converted); directions axis-aligned up to flips, or
+  orthogonal (a rotated lattice: kept as ``VolumeGrid.direction``; a shear raises). Without
   them, ``spacings`` and ``axis mins``/``axis maxs`` (cell centering adds half a step) give it.
 """
 
@@ -25,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from .raw import with_byteorder
-from .volume_samples import VolumeSamples, axis_signs, check_samples, check_size, pick_component
+from .volume_samples import (VolumeSamples, axis_signs, check_samples, check_size, orthonormal_direction,
+                             pick_component)
 
 __all__ = ["read_nrrd"]
 
@@ -177,8 +179,11 @@ def read_nrrd(path: Path, scalars, component) -> VolumeSamples:
         keep = list(range(ndim))
     check_samples(arr, where)
     check_size(arr.shape, where)
-    step, origin = _geometry(path, f, sp_dirs, keep, ndim, sizes)
-    return VolumeSamples.from_steps(arr, origin, step, sizes, where, f.get("content"))
+    step, origin, rotation = _geometry(path, f, sp_dirs, keep, ndim, sizes)
+    samples = VolumeSamples.from_steps(arr, origin, step, sizes, where, f.get("content"))
+    if rotation is not None:  # a rotated orthogonal lattice: positive steps, the first sample is the origin
+        samples.direction = rotation
+    return samples
 
 
 def _read_data(path: Path, f: dict, data_offset: int, dt: np.dtype, sizes: list) -> np.ndarray:
@@ -245,7 +250,7 @@ def _read_data(path: Path, f: dict, data_offset: int, dt: np.dtype, sizes: list)
 
 
 def _geometry(path: Path, f: dict, sp_dirs, keep: list, ndim: int, sizes: list) -> tuple:
-    """``(step, origin)``: signed world step of each spatial index axis and the first sample's position."""
+    """``(step, origin, rotation)``: signed world step of each spatial index axis and the first sample's position."""
     if sp_dirs is not None:
         if any(len(v) != 3 for v in sp_dirs):
             raise ValueError(f"{path}: space directions {sp_dirs} are not 3-D vectors; a volume needs a 3-D space.")
@@ -253,13 +258,20 @@ def _geometry(path: Path, f: dict, sp_dirs, keep: list, ndim: int, sizes: list) 
         lengths = np.linalg.norm(m, axis=0)
         if np.any(lengths == 0):
             raise ValueError(f"{path}: a space direction is the zero vector: {sp_dirs}.")
-        axis_signs(np.where(np.abs(m) <= 1e-9 * lengths[None, :], 0.0, m) / lengths[None, :], str(path))
-        step = np.diag(m).copy()
+        unit = np.where(np.abs(m) <= 1e-9 * lengths[None, :], 0.0, m) / lengths[None, :]
+        rotation = None
+        try:
+            axis_signs(unit, str(path))
+            step = np.diag(m).copy()
+        except ValueError:  # rotated orthogonal axes are kept as a direction; a shear raises here
+            rotation = orthonormal_direction(unit, str(path))
+            step = lengths.copy()
         origin = np.zeros(3)
         if "space origin" in f:
             origin = np.array(_nrrd_vectors(f["space origin"], path)[0], dtype=np.float64)
             if origin.shape != (3,):
                 raise ValueError(f"{path}: space origin {f['space origin']!r} is not a 3-D point.")
+        return step, origin, rotation
     else:
         def per_axis(key):
             if key not in f:
@@ -284,4 +296,4 @@ def _geometry(path: Path, f: dict, sp_dirs, keep: list, ndim: int, sizes: list) 
                 origin[a] = mins[a] + (0.5 * step[a] if cell else 0.0)
         if np.any(step == 0) or not np.isfinite(step).all():
             raise ValueError(f"{path}: spacings {step.tolist()} must be finite and nonzero.")
-    return step, origin
+    return step, origin, None

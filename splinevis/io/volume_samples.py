@@ -16,7 +16,7 @@ import numpy as np
 from ._common import check_exact_in_float64, check_real_dtype
 
 __all__ = ["VolumeSamples", "GEOMETRY_ARGS_APPLY_TO", "check_samples", "check_size", "pick_component", "from_array",
-           "axis_signs"]
+           "axis_signs", "orthonormal_direction"]
 
 #: The sources ``spacing=``/``origin=`` are meant for (the others carry their own geometry).
 GEOMETRY_ARGS_APPLY_TO = "numpy arrays and raw files"
@@ -52,6 +52,7 @@ class VolumeSamples:
     source: str
     scalars: str | None = None
     flips: tuple = (False, False, False)
+    direction: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
     @classmethod
     def from_steps(cls, values, first, steps, counts, source: str, scalars=None) -> VolumeSamples:
@@ -270,3 +271,39 @@ def axis_signs(direction: np.ndarray, where: str) -> np.ndarray:
                      "direction would draw a wrong picture. Resample onto an axis-aligned grid first "
                      "(e.g. in 3D Slicer or SimpleITK), or set the direction to the identity if you know the "
                      "orientation does not matter.")
+
+
+def orthonormal_direction(direction, where: str) -> tuple:
+    """``direction`` as a 3 x 3 nested tuple of floats whose columns are orthonormal; else ValueError.
+
+    Columns are re-orthonormalised (entries within ``1e-6`` of an orthonormal matrix pass; the result is
+    exactly orthonormal to rounding). A shear, non-unit or non-orthogonal axis raises.
+
+    Parameters
+    ----------
+    direction : (3, 3) array_like
+        Columns: the world direction of the lattice axes x, y, z.
+    where : str
+        The source, for the message.
+
+    Examples
+    --------
+    >>> orthonormal_direction(np.eye(3), "x")[0]
+    (1.0, 0.0, 0.0)
+    >>> orthonormal_direction([[1, 0.5, 0], [0, 1, 0], [0, 0, 1]], "a.cube")
+    Traceback (most recent call last):
+    ValueError: a.cube: the direction matrix [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] is not orthonormal (a shear or non-orthogonal axes, deviation 0.5); only rotated orthogonal lattices are drawn. Resample onto an orthogonal lattice first (e.g. scipy.ndimage.map_coordinates).
+    """
+    d = np.asarray(direction, dtype=np.float64)
+    if d.shape != (3, 3) or not np.isfinite(d).all():
+        raise ValueError(f"{where}: direction matrix {np.asarray(direction).tolist()} is not a finite 3 x 3 matrix "
+                         "(columns: world direction of the lattice axes x, y, z).")
+    dev = float(np.abs(d.T @ d - np.eye(3)).max())
+    if dev > 1e-6:
+        raise ValueError(f"{where}: the direction matrix {np.round(d, 12).tolist()} is not orthonormal (a shear or "
+                         f"non-orthogonal axes, deviation {dev:.3g}); only rotated orthogonal lattices are drawn. "
+                         "Resample onto an orthogonal lattice first (e.g. scipy.ndimage.map_coordinates).")
+    if dev > 0:
+        u, _, vt = np.linalg.svd(d)
+        d = u @ vt
+    return tuple(tuple(float(x) for x in row) for row in d)

@@ -1,7 +1,8 @@
 """Volumes from pyvista/VTK data objects and from the files VTK reads for us.
 
 Objects: ``ImageData``/``vtkImageData`` (point or cell data, direction matrix honoured when it only
-flips axes), uniform ``RectilinearGrid`` and axis-aligned uniform ``StructuredGrid``. Files, through
+flips axes; a rotated orthogonal lattice keeps its direction in ``VolumeGrid.direction``, a shear
+raises), uniform ``RectilinearGrid`` and axis-aligned uniform ``StructuredGrid``. Files, through
 :func:`pyvista.read`: ``.vti .vtk .vtr .vts``, MetaImage ``.mha .mhd`` (``vtkMetaImageReader``) and
 ``.slc`` (``vtkSLCReader``).
 
@@ -24,7 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from ._common import nonuniform_message, step_deviation
-from .volume_samples import VolumeSamples, axis_signs, check_samples, check_size, pick_component
+from .volume_samples import (VolumeSamples, axis_signs, check_samples, check_size, orthonormal_direction,
+                             pick_component)
 
 __all__ = ["from_pyvista", "read_vtk_file"]
 
@@ -156,10 +158,23 @@ def from_pyvista(grid, where: str, scalars, component) -> VolumeSamples:
         origin = np.array(grid.origin, dtype=np.float64)
         extent = np.array(grid.extent, dtype=np.int64)[0::2]
         direction = np.asarray(grid.direction_matrix, dtype=np.float64)
-        sign = axis_signs(direction, where)
+        try:
+            sign = axis_signs(direction, where)
+            rotation = None
+        except ValueError:  # a rotated orthogonal lattice is kept with its direction; a shear raises here
+            rotation = np.asarray(orthonormal_direction(direction * np.sign(spacing)[None, :], where))
+            sign = np.ones(3)
         first = origin + direction @ (extent * spacing)  # world position of the first stored point
-        axes_step = sign * spacing  # world step of the stored index along each axis
         assoc, name, arr = _choose_array(grid, where, scalars)
+        if rotation is not None:
+            if assoc == "cell":
+                first = first + direction @ (0.5 * spacing)
+                dims = tuple(max(d - 1, 1) for d in dims)
+            samples = _lattice_samples(arr, dims, np.zeros(3), np.abs(spacing), where, name, component)
+            samples.origin = tuple(float(v) for v in first)
+            samples.direction = tuple(tuple(float(x) for x in row) for row in rotation)
+            return samples
+        axes_step = sign * spacing  # world step of the stored index along each axis
         if assoc == "cell":
             first = first + 0.5 * axes_step
             dims = tuple(max(d - 1, 1) for d in dims)
@@ -224,3 +239,24 @@ def _coords_samples(grid, coords, where, scalars, component, eps=None) -> Volume
         dims = tuple(d - 1 for d in dims)
     return _lattice_samples(arr, dims, first, np.array(steps), where, name, component)
 
+
+
+def metaimage_direction(path: Path, where: str):
+    """The direction matrix of a MetaImage header (``TransformMatrix``/``Orientation``/``Rotation``), or None.
+
+    MetaIO lists the direction vector of each index axis in turn (ITK's convention: the columns of the
+    direction matrix); ``vtkMetaImageReader`` takes the list row by row, i.e. it transposes a rotation.
+    Axis flips (diagonal) are the same either way.
+    """
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16).decode("latin-1")
+    for line in head.splitlines():
+        key, sep, val = line.partition("=")
+        if sep and key.strip().lower() in ("transformmatrix", "orientation", "rotation"):
+            vals = [float(v) for v in val.split()]
+            if len(vals) != 9:
+                raise ValueError(f"{where}: {key.strip()} has {len(vals)} numbers; a 3-D image needs 9.")
+            return np.array(vals, dtype=np.float64).reshape(3, 3).T
+        if key.strip().lower() == "elementdatafile":
+            break
+    return None

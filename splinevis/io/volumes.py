@@ -19,6 +19,8 @@
   ``.nrrd`` ``.nhdr``       NRRD, parsed here (raw, gzip, bzip2, ascii, hex encodings)
   ``.slc``                  SLC (``vtkSLCReader``; 8-bit, no origin in the format)
   ``.raw`` ``.bin``         headerless samples: pass ``shape``, ``dtype``, ``byteorder``
+  ``.cube``                 Gaussian cube (parsed here), rotated orthogonal lattice -> ``direction``
+  folder or glob            stack of raw slices (``shape=(ny, nx)``, ``dtype``, ``byteorder``)
   ========================  ===============================================================
 
 This module holds the result and the dispatch; the readers live in :mod:`.volume_vtk` (pyvista/VTK
@@ -51,6 +53,11 @@ Conventions kept by every reader
   in world distance (anisotropic spacing counts, ``scipy.ndimage.distance_transform_edt``); a number
   ``fill=0.0`` puts that value into every gap.
 * At least 2 samples per axis (the spline schemes themselves need 3 and check that).
+* **Slice stacks.** A folder of headerless slice files (or a glob such as ``"ct/s_*.raw"``) with
+  ``shape=(ny, nx)``, ``dtype=``, ``byteorder=`` reads as one volume, the files sorted naturally by name
+  (:mod:`.slices`).
+* **Rotated orthogonal lattices.** Gaussian cube files (``.cube``, :mod:`.cube`) keep their axes in
+  ``VolumeGrid.direction``; their spacing and origin are in the file's units (Bohr).
 * DICOM series and NIfTI are not read (VTK's readers ignore parts of their orientation); convert them
   to NRRD or MetaImage first.
 """
@@ -69,8 +76,10 @@ from ._common import (VTK_FILES, check_geometry, fill_nearest, first_gap, freeze
                       refuse_own_geometry, require_regular_file, source_kind, unsupported_extension)
 from .nrrd import read_nrrd
 from .raw import read_raw
-from .volume_samples import GEOMETRY_ARGS_APPLY_TO, VolumeSamples, from_array
-from .volume_vtk import from_pyvista, read_vtk_file
+from .cube import read_cube
+from .slices import is_glob, read_slices
+from .volume_samples import GEOMETRY_ARGS_APPLY_TO, VolumeSamples, from_array, orthonormal_direction
+from .volume_vtk import from_pyvista, metaimage_direction, read_vtk_file
 
 __all__ = ["VolumeGrid", "read_volume", "VOLUME_EXTENSIONS"]
 
@@ -85,6 +94,7 @@ VOLUME_EXTENSIONS = {
     ".nrrd": "NRRD (parsed by splinevis)",
     ".nhdr": "NRRD detached header (parsed by splinevis)",
     ".slc": "SLC (vtkSLCReader)",
+    ".cube": "Gaussian cube, rotated orthogonal lattice (parsed by splinevis)",
     **dict.fromkeys(_RAW_EXTENSIONS, "headerless samples (shape=, dtype=, byteorder=)"),
 }
 _UNSUPPORTED = {
@@ -116,6 +126,12 @@ class VolumeGrid:
         How the values relate to the stored samples: ``values = slope * stored + intercept`` (already
         applied). ``(1.0, 0.0)`` for everything read from files; quantised synthetic samples
         (``datasets_synthetic.volumes``) record their scale here.
+    direction : (3, 3) nested tuples, orthonormal columns
+        World direction of the lattice axes x, y, z (the columns). Default: the identity. A rotated
+        orthogonal lattice (e.g. a Gaussian cube file) has world point ``origin + direction @ (i*dx, j*dy,
+        k*dz)``; ``bounds``, ``axes``, ``to_index``, ``to_world`` and ``to_pyvista`` describe the *lattice
+        frame* (the grid before the rotation); :meth:`lattice_to_world` applies the direction. A shear or
+        non-orthogonal direction raises ValueError.
 
     Examples
     --------
@@ -134,10 +150,12 @@ class VolumeGrid:
     scalars: str | None = None
     dtype: str = "float64"
     rescale: tuple = (1.0, 0.0)
+    direction: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
     def __post_init__(self):
         v = as_float64_array(self.values, "values", ndim=3)
         freeze_grid(self, "values", v, axes=3)
+        object.__setattr__(self, "direction", orthonormal_direction(self.direction, "VolumeGrid direction"))
         r = tuple(float(x) for x in self.rescale)
         if len(r) != 2 or not all(np.isfinite(r)) or r[0] == 0:
             raise ValueError(f"rescale must be (slope != 0, intercept), finite, got {self.rescale!r}.")
@@ -200,6 +218,27 @@ class VolumeGrid:
         """
         q = np.asarray(index_points, dtype=np.float64)
         return np.asarray(self.origin) + q * np.asarray(self.spacing)
+
+    @property
+    def is_rotated(self) -> bool:
+        """True unless ``direction`` is the identity.
+
+        >>> VolumeGrid(np.zeros((2, 2, 2))).is_rotated
+        False
+        """
+        return not np.array_equal(np.asarray(self.direction), np.eye(3))
+
+    def lattice_to_world(self, points) -> np.ndarray:
+        """Lattice-frame points ``(..., 3)`` (as :meth:`to_world` gives them) to true world points:
+        ``origin + direction @ (p - origin)``.
+
+        >>> g = VolumeGrid(np.zeros((2, 2, 2)), origin=(1.0, 0.0, 0.0), direction=((0, -1, 0), (1, 0, 0), (0, 0, 1)))
+        >>> g.lattice_to_world([2.0, 0.0, 0.0]).tolist()
+        [1.0, 1.0, 0.0]
+        """
+        p = np.asarray(points, dtype=np.float64)
+        o = np.asarray(self.origin)
+        return o + (p - o) @ np.asarray(self.direction).T
 
     def to_pyvista(self):
         """A ``pyvista.ImageData`` with the samples as point data ``"values"`` (x fastest, VTK order).
@@ -295,7 +334,8 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
 
     is_path = isinstance(source, (str, os.PathLike))
     raw_args = {"shape": shape, "dtype": dtype, "byteorder": byteorder}
-    if not is_path or Path(source).suffix.lower() not in _RAW_EXTENSIONS:
+    stack = is_path and (is_glob(source) or Path(source).is_dir())
+    if not stack and (not is_path or Path(source).suffix.lower() not in _RAW_EXTENSIONS):
         given = [k for k, v in raw_args.items() if v is not None] + (["header_bytes"] if header_bytes else [])
         if given and not (is_path and Path(source).suffix.lower() not in VOLUME_EXTENSIONS):
             raise ValueError(f"{' and '.join(given)}= describe headerless raw files (.raw, .bin); "
@@ -316,6 +356,10 @@ def _describe(source) -> str:
 
 def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes, component) -> VolumeSamples:
     kind = source_kind(source)
+    if kind == "path" and (is_glob(source) or Path(source).is_dir()):
+        if scalars is not None:
+            raise ValueError(f"{source}: scalars= names an array of a VTK file; raw slices hold one array.")
+        return read_slices(source, shape, dtype, byteorder, header_bytes, spacing, origin, component)
     if kind == "path":
         return _read_file(Path(source), scalars=scalars, spacing=spacing, origin=origin, shape=shape, dtype=dtype,
                           byteorder=byteorder, header_bytes=header_bytes, component=component)
@@ -338,10 +382,6 @@ def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, head
 def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes,
                component) -> VolumeSamples:
     ext = path.suffix.lower()
-    if path.is_dir():
-        raise ValueError(f"{path} is a directory; DICOM series are not read (VTK's reader drops parts of "
-                         "their orientation). Convert the series to NRRD or MetaImage first (e.g. with "
-                         "3D Slicer, SimpleITK or dcm2niix + conversion) and pass that file.")
     if ext in _UNSUPPORTED:
         raise ValueError(f"{path}: {_UNSUPPORTED[ext]} files are not read (VTK's readers ignore parts of their "
                          "orientation); convert to NRRD (.nrrd) or MetaImage (.mha) first. Supported: "
@@ -357,6 +397,9 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
         if scalars is not None:
             raise ValueError(f"{path}: scalars= names an array of a VTK file; a raw file holds one array.")
         return read_raw(path, shape, dtype, byteorder, header_bytes, spacing, origin, component)
+    if ext == ".cube":
+        refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
+        return read_cube(path, scalars, component)
     if ext in (".nrrd", ".nhdr"):
         refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
         return read_nrrd(path, scalars, component)
@@ -368,7 +411,10 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
             samples.origin = origin
         return samples
     refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
-    return from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component)
+    samples = from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component)
+    if ext in (".mha", ".mhd") and samples.direction != VolumeSamples.direction:
+        samples.direction = orthonormal_direction(metaimage_direction(path, str(path)), str(path))
+    return samples
 
 
 # --------------------------------------------------------------------------------------------------
@@ -396,4 +442,4 @@ def _finish(samples: VolumeSamples, fill) -> VolumeGrid:
             values = np.where(bad, float(fill), values)
     dtype = src_dtype.name if src_dtype.kind != "b" else "bool"
     return VolumeGrid(values=values, spacing=samples.spacing, origin=samples.origin, source=samples.source,
-                      scalars=samples.scalars, dtype=dtype)
+                      scalars=samples.scalars, dtype=dtype, direction=samples.direction)

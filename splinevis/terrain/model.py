@@ -131,6 +131,10 @@ class TerrainSpline:
 
             grid = smooth_heights(grid, presmooth)
         z = np.asarray(grid.heights, dtype=np.float64)
+        from .limits import check_grid_size
+
+        cell = 4 if scheme == "C0" else 1  # samples per spline cell
+        check_grid_size(max(1, (z.shape[1] - 1) // cell), max(1, (z.shape[0] - 1) // cell))  # before building
         z_ref = float(np.mean(z))
         coef, info = terrain_coefficients(z - z_ref, scheme)
         cell = info["cell_size"] if isinstance(info, dict) else info.cell_size

@@ -13,13 +13,14 @@ from .._validation import check_degree
 from ..bb.root_options import check_root_method, root_defines
 from ..gl.contract import SplineProgram
 from ..gl.error_bounds import model_frame_matrix, ray_depth_error_bound
-from ..gl.proxies import boxes, pack_rgba32f
+from ..gl.proxies import ROWS_PER_TEXTURE, boxes, pack_rgba32f, split_table
 from ..gl.spec import ProgramSpec
 from .hard_cases import hard_cases
+from .limits import check_grid_size
 from .model import TerrainSpline
 from .raycast import raycast_terrain
 
-__all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "terrain_depth_bound", "PROGRAM"]
+__all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_grid_size", "terrain_depth_bound", "PROGRAM"]
 
 ROOTS = ("bracketed", "paper")
 #: Levels the shader's hierarchy uniforms hold.
@@ -42,7 +43,7 @@ def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
     ncy, ncx = terrain.shape
     flat = np.zeros((ncy, ncx, 32), dtype=np.float32)
     flat[..., :30] = terrain.coefficients.reshape(ncy, ncx, 30)
-    return pack_rgba32f(flat, name="terrain coefficient table")
+    return pack_rgba32f(flat, name="terrain coefficient table", split=True)
 
 
 def hierarchy_table(terrain: TerrainSpline):
@@ -72,14 +73,16 @@ def hierarchy_table(terrain: TerrainSpline):
 
 
 def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: int = 8, max_steps: int | None = None,
-                    hierarchy: bool | int = True, roots: str = "bracketed") -> ProgramSpec:
+                    hierarchy: bool | int = True, roots: str = "bracketed",
+                    rows_per_texture: int = ROWS_PER_TEXTURE) -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
     ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
     secure starting points [Reis2008, sec. V]); names as in :mod:`splinevis.bb.root_options`.
     ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
-    int caps the top level (what the benchmarks use to measure the hierarchy's effect). ``style`` decides
-    nothing here.
+    int caps the top level (what the benchmarks use to measure the hierarchy's effect).
+    ``rows_per_texture``: rows of one texture of the coefficient table (default: 1 GiB textures; smaller
+    values split small tables too, which the tests use to check the split path). ``style`` decides nothing.
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
@@ -98,6 +101,9 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
     check_root_method(roots, ROOTS, degree=4)
     ncy, ncx = terrain.shape
+    rows_per_texture = check_degree(rows_per_texture, "rows_per_texture", low=1, high=ROWS_PER_TEXTURE)
+    check_grid_size(ncx, ncy, rows_per_texture)
+    pieces = split_table(coefficient_table(terrain), rows_per_texture)
     levels = terrain.hierarchy.levels
     if len(levels) > MAX_LEVELS:
         raise ValueError(f"terrain of {ncx}x{ncy} cells needs {len(levels)} hierarchy levels; at most {MAX_LEVELS} "
@@ -115,7 +121,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     pad = 1e-6 * max(1.0, cmax - cmin)
     points, triangles = boxes([x0 - off[0], y0 - off[1], cmin - pad], [x1 - off[0], y1 - off[1], cmax + pad])
     sx, sy = terrain.cell_spacing
-    level_offsets, level_widths = np.zeros(MAX_LEVELS), np.zeros(MAX_LEVELS)
+    level_offsets, level_widths = np.zeros(MAX_LEVELS, np.int64), np.zeros(MAX_LEVELS, np.int64)
     level_offsets[: len(offsets)] = offsets
     level_widths[: len(widths)] = widths
     return ProgramSpec(
@@ -124,7 +130,8 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         points=points,
         triangles=triangles,
         offset=tuple(off),
-        defines=root_defines(roots),
+        defines={**root_defines(roots), "SV_TERRAIN_SPLIT": len(pieces) > 1, "SV_TERRAIN_SPLIT3": len(pieces) > 2,
+                 "SV_TERRAIN_SPLIT4": len(pieces) > 3, "SV_ROWS_PER_TEXTURE": int(rows_per_texture)},
         uniforms={
             "sv_level_offset[]": level_offsets,
             "sv_level_width[]": level_widths,
@@ -139,7 +146,8 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
             "sv_scalar_offset": float(terrain.z_ref),
             "sv_scalar_range": terrain.zrange,
         },
-        textures={"sv_terrain_coef": coefficient_table(terrain), "sv_terrain_minmax": table},
+        textures={"sv_terrain_minmax": table,
+                  **{"sv_terrain_coef" + (str(k) if k else ""): piece for k, piece in enumerate(pieces)}},
     )
 
 
@@ -176,5 +184,5 @@ def _model_from(heights, scheme: str = "C1", presmooth: int = 0, **read_options)
 PROGRAM = SplineProgram(
     "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
     hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
-    options=("max_steps", "hierarchy", "roots"),
+    options=("max_steps", "hierarchy", "roots", "rows_per_texture"),
     description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")

@@ -130,7 +130,7 @@ def isosurface_program(model: Isosurface, style=None, *, newton_iterations: int 
 
         textures["sv_color_data"] = pack_rgba32f(_pad(values), name="color_field texture")
         scalar_range = (float(values.min()), float(values.max()))
-    return ProgramSpec(
+    spec = ProgramSpec(
         name="isosurface",
         entry="programs/isosurface.glsl",
         points=points,
@@ -156,6 +156,10 @@ def isosurface_program(model: Isosurface, style=None, *, newton_iterations: int 
         attributes=attributes,
         varyings=varyings,
     )
+    frame = world_frame(spline)
+    if frame is not None:  # a rotated lattice: the actor draws the lattice frame rotated into the world
+        object.__setattr__(spec, "world_frame", frame)
+    return spec
 
 
 def set_isovalue(actor, isovalue: float) -> Relevant:
@@ -183,9 +187,16 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     model = actor.model
     if not isinstance(model, Isosurface):
         raise TypeError(f"set_isovalue needs the SplineActor of an Isosurface, got one of {type(model).__name__}.")
-    model.isovalue = float(isovalue)
-    if not np.isfinite(model.isovalue):
+    iso = float(isovalue)
+    if not np.isfinite(iso):
         raise ValueError(f"isovalue must be finite, got {isovalue!r}.")
+    old_iso = model.isovalue
+    model.isovalue = iso
+    try:
+        check_isovalue_in_range(model)
+    except ValueError:
+        model.isovalue = old_iso  # the actor keeps drawing the previous isosurface
+        raise
     spline, rel = model.spline, model.relevant
     defines = actor.spec.defines
     encoding = ("coefficients" if defines.get("SV_VOLUME_TABLE") else
@@ -223,6 +234,13 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
     ((2,), True)
     """
     sp = model.spline
+    frame = world_frame(sp)
+    if frame is not None:  # a rotated lattice: the camera matrix and the rays act on lattice-frame points
+        R, pivot = frame
+        W = np.eye(4)
+        W[:3, :3], W[:3, 3] = R, pivot - R @ pivot
+        matrix = np.asarray(matrix, dtype=np.float64) @ W
+        origins, directions = _lattice_rays(model, origins, directions)
     off = sp.origin
     lo, hi = sp.value_range
     ref = value_reference(sp)
@@ -237,7 +255,69 @@ def _model_from(volume, isovalue, scheme="quadratic", **read_options) -> Isosurf
     """An :class:`Isosurface` of a VolumeSpline, a VolumeGrid or anything :func:`splinevis.io.read_volume`
     reads (``scheme`` and ``read_options`` are ignored for a VolumeSpline)."""
     spline = volume if isinstance(volume, VolumeSpline) else VolumeSpline(volume, scheme, **read_options)
-    return Isosurface(spline, isovalue)
+    surface = Isosurface(spline, isovalue)
+    check_isovalue_in_range(surface)
+    return surface
+
+
+def world_frame(spline):
+    """``(rotation, pivot)`` of a spline on a rotated lattice (world = pivot + rotation @ (lattice - pivot),
+    pivot = the grid origin), or None for an axis-aligned one.
+
+    >>> from splinevis.io import VolumeGrid
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> world_frame(VolumeSpline(sphere_grid(6))) is None
+    True
+    """
+    grid = spline.grid
+    if not getattr(grid, "is_rotated", False):
+        return None
+    return np.asarray(grid.direction, dtype=np.float64), np.asarray(grid.origin, dtype=np.float64)
+
+
+def _lattice_rays(model, origins, directions):
+    """World rays into the lattice frame of a rotated volume (unchanged for an axis-aligned one)."""
+    frame = world_frame(model.spline)
+    if frame is None:
+        return origins, directions
+    R, pivot = frame
+    o = np.asarray(origins, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    return pivot + (o - pivot) @ R, d @ R  # R^T (o - pivot) + pivot, R^T d (row vectors)
+
+
+def raycast_world(model: Isosurface, origins, directions, tmin=0.0, **options):
+    """:func:`~splinevis.volume.raycast.raycast_isosurface` on WORLD rays: for a volume on a rotated lattice
+    the rays are first mapped into the lattice frame (``t`` is the same: the map is a rigid motion).
+
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)
+    >>> float(raycast_world(surface, [[0.0, 0.0, 3.0]], [[0.0, 0.0, -1.0]]).t[0]) == float(
+    ...     raycast_isosurface(surface, [[0.0, 0.0, 3.0]], [[0.0, 0.0, -1.0]]).t[0])
+    True
+    """
+    o, d = _lattice_rays(model, origins, directions)
+    return raycast_isosurface(model, o, d, tmin, **options)
+
+
+def check_isovalue_in_range(surface: Isosurface, what: str = "isovalue") -> None:
+    """Raise ValueError when the isosurface is empty because the isovalue lies outside the data range.
+
+    An isovalue outside ``[min, max]`` of the samples whose spline still reaches it (an overshoot of
+    the spline between samples) is drawn; only an empty one raises. The message gives the range and
+    what to do. (An empty :class:`Isosurface` built directly stays allowed: ``add_spline`` draws nothing.)
+
+    >>> from splinevis.volume.hard_cases import sphere_grid
+    >>> check_isovalue_in_range(Isosurface(VolumeSpline(sphere_grid(6)), 9.0))
+    Traceback (most recent call last):
+    ValueError: isovalue=9.0 lies outside the volume's data range [...]: the isosurface is empty (a blank picture). Pass an isovalue inside that range, e.g. its middle ...
+    """
+    lo, hi = (float(v) for v in surface.spline.value_range)
+    iso = surface.isovalue
+    if not lo <= iso <= hi and len(surface.relevant.cubes) == 0:
+        raise ValueError(f"{what}={iso!r} lies outside the volume's data range [{lo!r}, {hi!r}]: the isosurface is "
+                         f"empty (a blank picture). Pass an isovalue inside that range, e.g. its middle "
+                         f"{0.5 * (lo + hi)!r}.")
 
 
 def attach_culling(actor, plotter, *, culling: bool = True) -> None:
@@ -263,8 +343,8 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
     (0, 0)
     >>> pl.close()
     """
-    if not culling:
-        return
+    if not culling or world_frame(actor.model.spline) is not None:
+        return  # the culler tests axis-aligned blocks in the world: not for a rotated lattice (drawn whole)
     spec, model = actor.spec, actor.model
     blocks = bool(spec.defines.get("SV_VOLUME_BLOCKS"))
     B = int(spec.uniforms.get("sv_block_size", BLOCK_SIZE)) if blocks else 1
@@ -281,7 +361,7 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
 
 
 PROGRAM = SplineProgram(
-    "isosurface", "raycast", Isosurface, isosurface_program, reference=raycast_isosurface,
+    "isosurface", "raycast", Isosurface, isosurface_program, reference=raycast_world,
     depth_bound=isosurface_depth_bound, hard_cases=hard_cases, model_from=_model_from, on_add=attach_culling,
     root_methods=ROOTS, newton_iterations=6, options=("encoding", "roots", "color_field", "proxy", "block_size"),
     description="isosurface of a trivariate spline on the type-6 partition, ray-cast in relevant cubes")

@@ -2,6 +2,7 @@
 // texelFetch (no filtering, exact float32). Texel n sits at (n % W, n / W). The Python side is
 // splinevis.gl.proxies.pack_rgba32f; the width is the same for every program (a test checks the two).
 const int SV_TABLE_WIDTH = 8192;
+// Rows of one texture of a split table (splinevis.gl.proxies.ROWS_PER_TEXTURE: 1 GiB per texture).
 
 // Texture coordinates of texel n. A record of k texels starting at a multiple of k, k dividing
 // SV_TABLE_WIDTH, lies in one row: fetch it at sv_table_address(first) + ivec2(q, 0).
