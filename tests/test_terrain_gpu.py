@@ -114,3 +114,15 @@ def test_coefficient_table_split_into_textures_gives_the_same_image():
     assert all(np.array_equal(images[8192], im) for im in images.values())
     with pytest.raises(ValueError, match="needs 8 textures of 1024 MB.*at most 4"):
         TerrainSpline.from_heights(np.zeros((8001, 8001)), "linear")  # refused before 15 GB of coefficients
+
+
+def test_colormap_spans_the_data_not_the_schemes_overshoot():
+    # C0 overshoots at a cliff; the colormap's default range is the data's, so the plateau and the floor get
+    # the two ends of the colormap instead of two middle colours
+    z = np.zeros((17, 17))
+    z[:, 9:] = 100.0
+    t = TerrainSpline.from_heights(z, "C0", spacing=(1.0, 1.0))
+    assert t.zrange[1] > 100.0 and t.zrange[0] < 0.0  # the overshoot exists
+    from splinevis.terrain.program import terrain_program
+
+    assert terrain_program(t).uniforms["sv_scalar_range"] == (0.0, 100.0)

@@ -92,6 +92,10 @@ class TerrainSpline:
         self.z_ref = z_ref
         self.scheme = scheme
         self.source = source
+        #: (min, max) of the height data the spline was built from (None: built from coefficients); what a
+        #: colormap spans by default: the coefficients' range includes the schemes' overshoot at cliffs and
+        #: edges (C0: several %), which squeezed the data into a few colours.
+        self.data_range = None
         self._pyramid = None
 
     @classmethod
@@ -139,7 +143,9 @@ class TerrainSpline:
         coef, info = terrain_coefficients(z - z_ref, scheme)
         cell = info["cell_size"] if isinstance(info, dict) else info.cell_size
         sp = (grid.spacing[0] * cell, grid.spacing[1] * cell)
-        return cls(coef, sp, grid.origin, z_ref, scheme=scheme, source=grid.source)
+        out = cls(coef, sp, grid.origin, z_ref, scheme=scheme, source=grid.source)
+        out.data_range = (float(np.min(z)), float(np.max(z)))
+        return out
 
     # -- data -----------------------------------------------------------------------------------------
     @property

@@ -144,7 +144,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
             "sv_max_steps": int(max_steps if max_steps is not None else 4 * (ncx + ncy) + 64),
             "sv_newton_iterations": iterations,
             "sv_scalar_offset": float(terrain.z_ref),
-            "sv_scalar_range": terrain.zrange,
+            "sv_scalar_range": terrain.data_range if terrain.data_range is not None else terrain.zrange,
         },
         textures={"sv_terrain_minmax": table,
                   **{"sv_terrain_coef" + (str(k) if k else ""): piece for k, piece in enumerate(pieces)}},
