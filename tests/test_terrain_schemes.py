@@ -315,3 +315,17 @@ def test_evaluate_outside_domain():
     coef, info = terrain_coefficients(np.zeros((5, 5)), "C2")
     with pytest.raises(ValueError, match="outside"):
         evaluate(coef, info, [1.0, 4.5], [1.0, 1.0])
+
+
+def test_c0_takes_any_grid_size_by_resampling_onto_4k_plus_1():
+    from splinevis.terrain.model import TerrainSpline
+
+    y, x = np.mgrid[0:23, 0:30].astype(float)
+    z = 0.01 * x ** 3 + y  # a cubic: reproduced by the resampling and by C0 (quartic interpolation)
+    t = TerrainSpline.from_heights(z, "C0", spacing=(2.0, 3.0), origin=(10.0, 20.0))
+    assert "resampled from 30x23 to 33x25 samples for C0" in t.source
+    x0, x1, y0, y1 = t.extent
+    assert (x0, y0) == (10.0, 20.0) and abs(x1 - (10.0 + 29 * 2.0)) < 1e-9 and abs(y1 - (20.0 + 22 * 3.0)) < 1e-9
+    xs, ys = 10.0 + 2.0 * np.array([0.0, 7.3, 29.0]), 20.0 + 3.0 * np.array([0.0, 11.1, 22.0])
+    i, j = (xs - 10.0) / 2.0, (ys - 20.0) / 3.0
+    assert np.allclose(t.evaluate(xs, ys), 0.01 * i ** 3 + j, atol=1e-9)

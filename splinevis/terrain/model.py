@@ -114,7 +114,9 @@ class TerrainSpline:
     def from_heights(cls, heights, scheme: str = "C1", *, presmooth: int = 0, **read_options) -> "TerrainSpline":
         """Apply ``scheme`` to height data (anything :func:`splinevis.io.read_heights` reads).
 
-        ``presmooth`` > 0 first smooths the heights with that many passes of the binomial filter on the GPU
+        Scheme ``"C0"`` works on macro cells of 4 x 4 samples: grids of other sizes are resampled onto the
+        next ``4k + 1`` grid over the same rectangle (:func:`splinevis.terrain.schemes.resample_for_c0`; the
+        model's ``source`` says so). ``presmooth`` > 0 first smooths the heights with that many passes of the binomial filter on the GPU
         (:func:`splinevis.terrain.prefilter.smooth_heights`: for noisy measured data).
 
         Examples
@@ -135,6 +137,17 @@ class TerrainSpline:
 
             grid = smooth_heights(grid, presmooth)
         z = np.asarray(grid.heights, dtype=np.float64)
+        spacing = grid.spacing
+        source = grid.source
+        if scheme == "C0" and ((z.shape[0] - 1) % 4 or (z.shape[1] - 1) % 4) and min(z.shape) >= 4:
+            # C0's macro cells are 4 x 4 samples: other sizes are resampled onto the 4k + 1 grid spanning the
+            # same rectangle (cubic interpolation, resample_for_c0), documented in the model's source
+            from .schemes import resample_for_c0
+
+            shape = z.shape
+            z, (sx, sy) = resample_for_c0(z)
+            spacing = (spacing[0] * sx, spacing[1] * sy)
+            source = f"{source} (resampled from {shape[1]}x{shape[0]} to {z.shape[1]}x{z.shape[0]} samples for C0)"
         from .limits import check_grid_size
 
         cell = 4 if scheme == "C0" else 1  # samples per spline cell
@@ -142,8 +155,8 @@ class TerrainSpline:
         z_ref = float(np.mean(z))
         coef, info = terrain_coefficients(z - z_ref, scheme)
         cell = info["cell_size"] if isinstance(info, dict) else info.cell_size
-        sp = (grid.spacing[0] * cell, grid.spacing[1] * cell)
-        out = cls(coef, sp, grid.origin, z_ref, scheme=scheme, source=grid.source)
+        sp = (spacing[0] * cell, spacing[1] * cell)
+        out = cls(coef, sp, grid.origin, z_ref, scheme=scheme, source=source)
         out.data_range = (float(np.min(z)), float(np.max(z)))
         return out
 
