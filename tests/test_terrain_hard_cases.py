@@ -43,11 +43,18 @@ def test_step_cliff_overshoot_is_measured_and_bounded():
 @pytest.mark.parametrize("scheme, shape, match", [
     ("C2", (3, 5), r"needs at least"),
     ("C1", (2, 2), r"needs at least"),
-    ("C0", (6, 6), r"resample_for_c0"),
 ])
 def test_grids_smaller_than_the_stencil_or_misfit_are_refused(scheme, shape, match):
     with pytest.raises(ValueError, match=match):
         TerrainSpline.from_heights(np.zeros(shape), scheme)
+
+
+def test_c0_misfit_sizes_are_refused_by_the_low_level_scheme_and_resampled_by_the_model():
+    from splinevis.terrain.schemes import terrain_coefficients
+
+    with pytest.raises(ValueError, match=r"resample_for_c0"):
+        terrain_coefficients(np.zeros((6, 6)), "C0")
+    assert TerrainSpline.from_heights(np.zeros((6, 6)), "C0").shape == (2, 2)  # 9 x 9 samples: 2 x 2 macro cells
 
 
 def test_nan_cells_are_refused_by_default_and_filled_on_request():
