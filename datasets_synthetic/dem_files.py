@@ -52,7 +52,8 @@ def _i6(v: int) -> str:
 
 
 def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, utm_zone: int = 33,
-                         label: str = "splinevis synthetic DEM") -> Path:
+                         label: str = "splinevis synthetic DEM", clip_profiles: bool = False,
+                         corners=None) -> Path:
     """Write a minimal USGS ASCII DEM (planimetric system UTM, metres in x, y and z).
 
     Parameters
@@ -71,6 +72,13 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
         Zone written in the header (metadata only; the coordinates need not be real UTM).
     label : str
         First 144 characters of the header.
+    clip_profiles : bool
+        Write each profile only from its first to its last non-NaN sample, starting at that sample's
+        own northing (as USGS 7.5-minute DEMs clipped by the quadrangle do); a column of only NaN
+        is written as a one-sample void profile at its southern node.
+    corners : four (x, y) pairs, optional
+        Quadrangle corners SW, NW, NE, SE for the header (need not lie on the sample lattice).
+        Default: the corner samples.
 
     Returns
     -------
@@ -115,21 +123,25 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
     a += _i6(1) + _i6(1) + _i6(1) + _i6(utm_zone)  # level 1, regular pattern, UTM, zone
     a += "".join(_d24(0.0) for _ in range(15))  # projection parameters (unused for UTM)
     a += _i6(2) + _i6(2) + _i6(4)  # plane unit metres, elevation unit metres, 4 sides
-    for cx, cy in ((x0, y0), (x0, yn), (xe, yn), (xe, y0)):  # SW, NW, NE, SE
+    for cx, cy in corners or ((x0, y0), (x0, yn), (xe, yn), (xe, y0)):  # SW, NW, NE, SE
         a += _d24(cx) + _d24(cy)
     a += _d24(zmin) + _d24(zmax) + _d24(0.0) + _i6(0)  # elevation bounds, rotation, accuracy code
     a += "".join(f"{v:12.6E}" for v in (dx, dy, z_resolution))
     a += _i6(1) + _i6(nx)  # rows (1 for a regular DEM), columns = number of profiles
     records = [a.ljust(1024)]
     for i in range(nx):
-        col = k[:, i]
+        col, j0 = k[:, i], 0
+        if clip_profiles:
+            rows = np.flatnonzero(np.isfinite(h[:, i]))
+            j0 = int(rows[0]) if rows.size else 0
+            col = col[j0:int(rows[-1]) + 1] if rows.size else col[:1]
         good = col[col != DEM_VOID]
         lo_hi = (float(good.min()) * z_resolution, float(good.max()) * z_resolution) if good.size else (0.0, 0.0)
-        head = _i6(1) + _i6(i + 1) + _i6(ny) + _i6(1)
-        head += _d24(x0 + i * dx) + _d24(y0) + _d24(0.0) + _d24(lo_hi[0]) + _d24(lo_hi[1])
+        head = _i6(1) + _i6(i + 1) + _i6(col.size) + _i6(1)
+        head += _d24(x0 + i * dx) + _d24(y0 + j0 * dy) + _d24(0.0) + _d24(lo_hi[0]) + _d24(lo_hi[1])
         cells = [_i6(v) for v in col]
         blocks = [head + "".join(cells[:146])]
-        for s in range(146, ny, 170):
+        for s in range(146, col.size, 170):
             blocks.append("".join(cells[s:s + 170]))
         records.extend(b.ljust(1024) for b in blocks)
     path = Path(path)

@@ -233,7 +233,7 @@ def test_missing_file_and_unknown_extension(tmp_path):
 # ---- USGS ASCII DEM ---------------------------------------------------------------------------------------
 # Precision of the format: corners D24.15 (16 significant digits), spacing E12.6 (7 significant
 # digits), elevations integers times z_resolution (0.01 m here): heights within z_resolution / 2.
-@pytest.mark.parametrize("nx", [6, 100])  # 6: parsed in Python (VTK 9.7.1 divides by zero < 100), 100: vtkDEMReader
+@pytest.mark.parametrize("nx", [6, 100])  # both parsed by our reader (vtkDEMReader is no longer used)
 def test_usgs_dem_round_trip(tmp_path, nx):
     ny = 7
     h = 250.0 + 0.123 * plane(nx, ny, 30.0, 10.0) + 17.0 * np.sin(np.arange(nx))[None, :]
@@ -256,6 +256,49 @@ def test_usgs_dem_void_is_reported_with_file_position(tmp_path):
     g = read_heights(path, fill="linear")
     np.testing.assert_allclose(g.heights[1, 7], 100.0 + plane(100, 3, 30.0, 10.0)[1, 7], atol=0.002)
     assert DEM_VOID == -32767
+
+
+def test_usgs_dem_clipped_profiles_land_at_their_own_northing(tmp_path):
+    # A 7.5-minute-style DEM: every profile starts at its own northing and has its own length; the
+    # quadrangle corners lie off the sample lattice. vtkDEMReader put such profiles rows too far south
+    # and filled the uncovered nodes with the file minimum; each sample must land at its true (x, y)
+    # and uncovered nodes must be missing.
+    nx, ny, dx, dy = 120, 40, 30.0, 30.0
+    jj, ii = np.mgrid[0:ny, 0:nx]
+    h = 1000.0 + 3.0 * ii + 7.0 * jj  # a plane: the true height at node (i, j) is known
+    first = (ii[0] * 13) % 9  # first row of each profile (0..8)
+    last = ny - 1 - (ii[0] * 7) % 11  # last row (29..39)
+    first[0] = 3  # the westmost profile starts north of the south-west node
+    first[5] = 0  # another starts on row 0, so the south-west node is (x0, y0)
+    inside = (jj >= first[None, :]) & (jj <= last[None, :])
+    h[~inside] = np.nan
+    x0, y0 = 500010.0, 5100020.0
+    corners = ((x0 - 6.0, y0 - 19.0), (x0 - 6.0, y0 + 1200.0), (x0 + 3600.0, y0 + 1200.0), (x0 + 3600.0, y0 - 19.0))
+    path = write_usgs_ascii_dem(tmp_path / "clip.dem", h, (dx, dy), (x0, y0), z_resolution=0.01,
+                                clip_profiles=True, corners=corners)
+    with pytest.raises(ValueError, match=r"clip\.dem: .* samples are missing"):
+        read_heights(path)  # uncovered nodes are reported, never silently filled
+    g = read_heights(path, fill="nearest")
+    assert g.shape == (ny, nx) and g.origin == (x0, y0) and g.spacing == (dx, dy)
+    true = 1000.0 + 3.0 * (g.x[None, :] - x0) / dx + 7.0 * (g.y[:, None] - y0) / dy
+    np.testing.assert_allclose(g.heights[inside], true[inside], atol=0.005)
+    assert g.height_range[0] >= 1000.0 - 0.005  # no node filled with a value from outside the data
+
+
+def test_usgs_dem_truncated_mid_profile_is_a_clear_error(tmp_path):
+    h = 100.0 + plane(120, 200, 30.0, 30.0)
+    path = write_usgs_ascii_dem(tmp_path / "full.dem", h, (30.0, 30.0), UTM)
+    np.testing.assert_allclose(read_heights(path).heights, h, atol=0.005)  # multi-block profiles read whole
+    data = path.read_bytes()
+    cut = tmp_path / "cut.dem"
+    cut.write_bytes(data[:len(data) * 2 // 3 + 500])  # cut inside a profile
+    with pytest.raises(ValueError, match=r"cut\.dem: truncated or malformed .*profile \d+ .*file ends after"):
+        read_heights(cut)
+    whole = tmp_path / "whole_profiles.dem"  # cut exactly after a complete profile record
+    per = (len(data) - 1024) // 120
+    whole.write_bytes(data[:1024 + 80 * per])
+    with pytest.raises(ValueError, match=r"whole_profiles\.dem: header says 120 profiles but the file holds 80"):
+        read_heights(whole)
 
 
 def test_dem_writer_refuses_float32_inexact_geometry(tmp_path):

@@ -1,18 +1,15 @@
-"""USGS ASCII DEM files (``.dem``): the type A header parsed here, elevations from ``vtkDEMReader``.
+"""USGS ASCII DEM files (``.dem``): type A header and type B profiles parsed here.
 
-Why partly our own parser:
+Why our own parser and not ``vtkDEMReader`` (nor GDAL's USGSDEM driver, not wired in yet):
 
-* The type A header is parsed here in float64 (corners D24.15: 16 significant digits; resolution
-  E12.6: 7 significant digits); ``vtkDEMReader`` works in float32.
-* ``vtkDEMReader`` returns ``integer * z_resolution`` in float32 and applies its own feet/arc-second
-  factors. The integers are recovered and multiplied by the resolution in float64, so heights are
-  exact multiples of the file's z resolution, in the file's units (``units`` and ``crs`` of the
-  result say what the file uses). The void value -32767 is a gap.
-* VTK 9.7.1's reader divides by zero (killing the process) on DEMs with fewer than 100 profiles, so
-  those are parsed in Python.
-
-Only north-up DEMs whose profiles all start on the southern row are placed correctly (VTK ignores each
-profile's start coordinate).
+* The type A header is parsed in float64 (corners D24.15: 16 significant digits; resolution E12.6:
+  7 significant digits); ``vtkDEMReader`` works in float32 and applies its own unit factors.
+* Heights are the stored integers times the z resolution in float64, in the file's units (``units``
+  and ``crs`` of the result say what the file uses). The void value -32767 is a gap.
+* ``vtkDEMReader`` ignores each profile's starting (x, y): profiles clipped by the quadrangle (USGS
+  7.5-minute DEMs) land rows off and uncovered nodes get the file minimum; it also accepts truncated
+  files. So the profiles are parsed here: each placed by its own start, uncovered nodes missing (the
+  gap logic of :func:`read_heights` reports or fills them), truncated files a ValueError.
 """
 
 from __future__ import annotations
@@ -39,8 +36,6 @@ _DEM_TOKEN = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[EeDd][-+]?\d+)?")
 #   853-864 rows, columns (number of profiles).
 _PLANE_UNITS = {0: "radians", 1: "ft", 2: "m", 3: "arc-seconds"}
 _ELEV_UNITS = {1: "ft", 2: "m"}
-# vtkDEMReader's own unit factors (to undo them: we keep the file's units).
-_VTK_UNIT_FACTOR = {1: 0.305, 3: 23.111}
 
 
 def _dem_float(field_text: str) -> float:
@@ -77,27 +72,89 @@ def _read_dem_header(path: Path) -> dict:
     return hdr
 
 
-def _dem_profiles_python(path: Path, nrows: int, ncols: int):
-    """Integer elevations (nrows, ncols), south row first, parsed in Python (small DEMs)."""
+def _dem_profiles(path: Path, dx: float, dy: float):
+    """Every type B profile placed by its own first-sample (x, y): integer elevations, origin, count.
+
+    Returns ``(k, (west, south), nprofiles)`` with ``k[row, col]`` south row first; nodes no profile
+    covers hold ``DEM_VOID`` (missing, never filled with a real height).
+    """
     with open(path, "rb") as fh:
         fh.seek(1024)
-        # Tokens, not whitespace-split fields: fixed-width I6 fields may touch ("  1234-12345").
-        tokens = _DEM_TOKEN.findall(fh.read().decode("ascii", errors="replace"))
-    k = np.full((nrows, ncols), DEM_VOID, dtype=np.int64)
-    pos = 0
+        body = fh.read().decode("ascii", errors="replace")
+    if "\n" not in body and "\r" not in body:
+        return _place(path, _fixed_width_profiles(path, body), dx, dy)
+    # Files with line breaks: tokens, not whitespace-split fields ("  1234-12345" touch).
+    tokens = _DEM_TOKEN.findall(body)
+    profiles, pos = [], 0
     try:
-        for _ in range(ncols):
+        while pos < len(tokens):
             row_id, col_id, m, n = (int(t) for t in tokens[pos:pos + 4])
+            x0, y0 = _dem_float(tokens[pos + 4]), _dem_float(tokens[pos + 5])
             pos += 9  # 4 integers, then x, y of the first sample, datum elevation, min, max
-            k[row_id - 1:row_id - 1 + m * n, col_id - 1] = [int(t) for t in tokens[pos:pos + m * n]]
+            data = [int(t) for t in tokens[pos:pos + m * n]]
+            if len(data) != m * n:
+                raise ValueError(f"profile {len(profiles) + 1} (column {col_id}) announces {m * n} "
+                                 f"elevations but the file ends after {len(data)}")
+            profiles.append((x0, y0, np.asarray(data, dtype=np.int64)))
             pos += m * n
     except (ValueError, IndexError) as exc:
-        raise ValueError(f"{path}: malformed type B (profile) record near token {pos} ({exc}).") from None
-    return k
+        raise ValueError(f"{path}: truncated or malformed type B (profile) record near token {pos} ({exc}). "
+                         "The file is incomplete or corrupt; download it again.") from None
+    return _place(path, profiles, dx, dy)
+
+
+def _fixed_width_profiles(path: Path, body: str) -> list:
+    """Type B records in 1024-character blocks: 144-character profile header, then I6 elevations
+    (146 in the first block, 170 in each further one). Six-digit elevations may touch, so fields are
+    cut by column, not by whitespace."""
+    profiles, pos = [], 0
+    while pos < len(body) and body[pos:].strip():
+        try:
+            head = body[pos:pos + 144]
+            row_id, col_id, m, n = (int(head[6 * q:6 * q + 6]) for q in range(4))
+            x0, y0 = _dem_float(head[24:48]), _dem_float(head[48:72])
+            count, cells, off, room = m * n, [], pos + 144, 146
+            while len(cells) < count:
+                take = min(room, count - len(cells))
+                chunk = body[off:off + 6 * take]
+                if len(chunk) < 6 * take:
+                    raise ValueError(f"profile {len(profiles) + 1} (column {col_id}) announces {count} "
+                                     f"elevations but the file ends after {len(cells) + len(chunk) // 6}")
+                cells.extend(int(chunk[6 * q:6 * q + 6]) for q in range(take))
+                off = (off - (off - pos) % 1024) + 1024 if len(cells) < count else off
+                room = 170
+        except ValueError as exc:
+            raise ValueError(f"{path}: truncated or malformed type B (profile) record at byte {1024 + pos} "
+                             f"({exc}). The file is incomplete or corrupt; download it again.") from None
+        profiles.append((x0, y0, np.asarray(cells, dtype=np.int64)))
+        nblocks = 1 + max(0, -(-(count - 146) // 170))
+        pos += 1024 * nblocks
+    return profiles
+
+
+def _place(path: Path, profiles: list, dx: float, dy: float):
+    if not profiles:
+        raise ValueError(f"{path}: no type B (profile) records after the header; the file is truncated.")
+    west = min(p[0] for p in profiles)
+    south = min(p[1] for p in profiles)
+    cols = [(p[0] - west) / dx for p in profiles]
+    rows = [(p[1] - south) / dy for p in profiles]
+    for what, idx in (("x", cols), ("y", rows)):
+        bad = [i for i, v in enumerate(idx) if abs(v - round(v)) > 1e-3]
+        if bad:
+            raise ValueError(f"{path}: profile {bad[0] + 1} starts at {what} off the sample lattice "
+                             f"(offset {idx[bad[0]]:.4g} steps); the DEM cannot be placed on one grid.")
+    cols, rows = [int(round(v)) for v in cols], [int(round(v)) for v in rows]
+    ncols = max(cols) + 1
+    nrows = max(r + p[2].size for r, p in zip(rows, profiles))
+    k = np.full((nrows, ncols), DEM_VOID, dtype=np.int64)
+    for c, r, p in zip(cols, rows, profiles):
+        k[r:r + p[2].size, c] = p[2]
+    return k, (west, south), len(profiles)
 
 
 def read_dem(path: Path, nodata) -> HeightSamples:
-    """Read a USGS ASCII DEM (north-up, profiles starting on the southern row).
+    """Read a USGS ASCII DEM (north-up; each profile placed by its own starting x, y).
 
     Parameters
     ----------
@@ -126,35 +183,14 @@ def read_dem(path: Path, nodata) -> HeightSamples:
     ('UTM zone 33 (x, y in m)', 'm')
     """
     hdr = _read_dem_header(path)
-    sw, nw, ne, se = hdr["corners"]
     dx, dy, dz = hdr["res"]
-    west, east = min(sw[0], nw[0]), max(ne[0], se[0])
-    south, north = min(sw[1], se[1]), max(nw[1], ne[1])
-    ncols = int(round((east - west) / dx)) + 1
-    nrows = int(round((north - south) / dy)) + 1
-    if ncols != hdr["ncols"]:
-        raise ValueError(f"{path}: header says {hdr['ncols']} profiles but the corners and x resolution "
-                         f"give {ncols}.")
-    if ncols >= 100:
-        from vtkmodules.util.numpy_support import vtk_to_numpy
-        from vtkmodules.vtkIOImage import vtkDEMReader
-
-        reader = vtkDEMReader()
-        reader.SetFileName(str(path))
-        reader.Update()
-        img = reader.GetOutput()
-        if tuple(img.GetDimensions()) != (ncols, nrows, 1):
-            raise ValueError(f"{path}: vtkDEMReader returned dims {img.GetDimensions()}, the header gives "
-                             f"{(ncols, nrows, 1)}.")
-        v = vtk_to_numpy(img.GetPointData().GetScalars()).reshape(nrows, ncols)
-        # VTK stores int * float32(dz * its unit factor) as float32; recover the integers (exact for
-        # |k| < 2**22) so that heights are k * dz in float64 in the file's unit.
-        u32 = np.float32(np.float32(dz) * np.float32(_VTK_UNIT_FACTOR.get(hdr["elev_unit"], 1.0)))
-        k = np.rint(v.astype(np.float64) / np.float64(u32)).astype(np.int64)
-    else:
-        # vtkDEMReader (VTK 9.7.1) divides by zero - killing the process - on DEMs with fewer than 100
-        # profiles (its progress interval is ncols / 100), so small DEMs are parsed here.
-        k = _dem_profiles_python(path, nrows, ncols)
+    # Every profile is placed by its own starting (x, y) (USGS 7.5-minute DEMs clip profiles at the
+    # quadrangle, so each starts at its own northing); the origin is the south-west lattice node,
+    # not the quadrangle corner (which is off the lattice).
+    k, (west, south), nprof = _dem_profiles(path, dx, dy)
+    if nprof != hdr["ncols"]:
+        raise ValueError(f"{path}: header says {hdr['ncols']} profiles but the file holds {nprof}; "
+                         "the file is truncated or corrupt.")
     values = k * dz
     missing = k == DEM_VOID
     if nodata is not None:

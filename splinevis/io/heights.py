@@ -5,8 +5,8 @@
 * a 2-D numpy array (``heights[j, i]``; ``spacing`` and ``origin`` default to ``(1, 1)`` and ``(0, 0)``),
 * a pyvista ``ImageData`` (or ``vtkImageData``) that is one x-y slice, ``dims == (nx, ny, 1)``,
 * a pyvista ``RectilinearGrid`` or ``StructuredGrid`` whose x, y coordinates form an axis-aligned lattice,
-* a file: ``.vti .vtk .vtr .vts`` (through :func:`pyvista.read`), ``.dem`` (USGS ASCII DEM, through
-  ``vtkDEMReader``) and ``.tif .tiff`` (GeoTIFF, through the optional package ``tifffile``).
+* a file: ``.vti .vtk .vtr .vts`` (through :func:`pyvista.read`), ``.dem`` (USGS ASCII DEM, our own
+  parser: see :mod:`.dem`) and ``.tif .tiff`` (GeoTIFF, through the optional package ``tifffile``).
 
 This module holds the result and the dispatch; the readers live in :mod:`.height_vtk` (pyvista grids
 and VTK files), :mod:`.dem` and :mod:`.geotiff`, each with its format notes; gap filling and resampling
@@ -56,7 +56,7 @@ _TIFF_EXTENSIONS = (".tif", ".tiff")
 #: File name extensions :func:`read_heights` reads, and by what.
 SUPPORTED_EXTENSIONS = {
     **{ext: f"{kind} (pyvista.read)" for ext, kind in VTK_FILES.items()},
-    ".dem": "USGS ASCII DEM (vtkDEMReader)",
+    ".dem": "USGS ASCII DEM (own parser)",
     **dict.fromkeys(_TIFF_EXTENSIONS, "GeoTIFF (tifffile)"),
 }
 
