@@ -379,3 +379,18 @@ def test_fractal_terrain_reproducible_and_scaled():
     assert np.array_equal(z, fractal_terrain(32, seed=3, amplitude=100.0))
     with pytest.raises(ValueError, match=r"n must be an integer >= 2, got 1"):
         fractal_terrain(1)
+
+
+@pytest.mark.parametrize("keep", [0, 0.5])
+def test_empty_or_truncated_vti_says_so(tmp_path, keep):
+    import pyvista as pv
+
+    src = tmp_path / "ok.vti"
+    g = pv.ImageData(dimensions=(8, 6, 1))
+    g.point_data["h"] = np.arange(48.0)
+    g.save(src)
+    bad = tmp_path / "bad.vti"
+    data = src.read_bytes()
+    bad.write_bytes(data[: int(len(data) * keep)])
+    with pytest.raises(ValueError, match=r"bad\.vti: .*(empty or truncated|could not read)"):
+        read_heights(bad)

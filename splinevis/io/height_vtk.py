@@ -56,10 +56,20 @@ def read_vtk_file(path: Path, description: str, scalars, nodata) -> HeightSample
     """
     import pyvista as pv
 
+    import warnings
+
     try:
-        grid = pv.read(path)
+        with warnings.catch_warnings(record=True) as caught:  # pyvista reports VTK reader errors as warnings
+            warnings.simplefilter("always")
+            grid = pv.read(path)
     except Exception as exc:  # pyvista raises a variety of types for unreadable files
         raise ValueError(f"{path}: pyvista could not read it as {description}: {exc}") from exc
+    vtk_errors = [str(w.message) for w in caught if "raised an error" in str(w.message)]
+    if vtk_errors or grid.n_points == 0:  # VTK's readers return an empty grid for an empty or cut file, with no error
+        size = Path(path).stat().st_size
+        why = f" (VTK: {vtk_errors[0].splitlines()[-1].strip()})" if vtk_errors else ""
+        raise ValueError(f"{path}: the file could not be read whole ({size} bytes): it is empty or truncated{why}; "
+                         f"write or download it again.")
     return from_pyvista(grid, str(path), scalars, nodata)
 
 
