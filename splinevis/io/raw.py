@@ -15,7 +15,7 @@ import numpy as np
 
 from .volume_samples import VolumeSamples, from_array
 
-__all__ = ["read_raw", "with_byteorder"]
+__all__ = ["sample_dtype", "read_raw", "with_byteorder"]
 
 
 def with_byteorder(dt: np.dtype, order: str) -> np.dtype:
@@ -36,6 +36,37 @@ def with_byteorder(dt: np.dtype, order: str) -> np.dtype:
     (dtype('>i2'), dtype('<f4'))
     """
     return dt.newbyteorder("<" if order == "little" else ">")
+
+
+def sample_dtype(where, dtype, byteorder, header_bytes) -> np.dtype:
+    """The numpy dtype of headerless samples, byte order applied, after checking ``dtype``, ``byteorder``
+    and ``header_bytes`` (errors name ``where``). Shared by raw files and raw slice stacks.
+
+    >>> sample_dtype("ct.raw", "uint16", "big", 0).str
+    '>u2'
+    """
+    try:
+        dt = np.dtype(dtype)
+    except TypeError:
+        raise ValueError(f"{where}: dtype {dtype!r} is not a numpy dtype; use e.g. 'uint8', 'uint16', 'int16', "
+                         "'int32', 'float32', 'float64'.") from None
+    if dt.kind not in "biuf":
+        raise TypeError(f"{where}: dtype {dt} is not a real number type.")
+    marker = dtype[0] if isinstance(dtype, str) and dtype[:1] in ("<", ">") else dt.byteorder
+    explicit = {"<": "little", ">": "big"}.get(marker)
+    if byteorder is not None and byteorder not in ("little", "big"):
+        raise ValueError(f"{where}: byteorder {byteorder!r} is not known; choose 'little' or 'big'.")
+    if explicit and byteorder and explicit != byteorder:
+        raise ValueError(f"{where}: dtype {dtype!r} says {explicit}-endian but byteorder={byteorder!r}.")
+    order = byteorder or explicit
+    if dt.itemsize > 1:
+        if order is None:
+            raise ValueError(f"{where}: {dt.name} samples take {dt.itemsize} bytes; pass byteorder='little' "
+                             "(most files from PCs) or byteorder='big' - a wrong guess reads plausible garbage.")
+        dt = with_byteorder(dt, order)
+    if isinstance(header_bytes, bool) or not isinstance(header_bytes, (int, np.integer)) or header_bytes < 0:
+        raise ValueError(f"{where}: header_bytes must be a non-negative int, got {header_bytes!r}.")
+    return dt
 
 
 def read_raw(path: Path, shape, dtype, byteorder, header_bytes, spacing, origin, component) -> VolumeSamples:
@@ -79,32 +110,12 @@ def read_raw(path: Path, shape, dtype, byteorder, header_bytes, spacing, origin,
         raise ValueError(f"{path}: a headerless raw file needs {' and '.join(m + '=' for m in missing)}, e.g. "
                          f"read_volume({str(path)!r}, shape=(nz, ny, nx), dtype='uint16', byteorder='little', "
                          "spacing=(dx, dy, dz), origin=(x0, y0, z0)); shape lists the slowest axis (z) first.")
-    try:
-        dt = np.dtype(dtype)
-    except TypeError:
-        raise ValueError(f"{path}: dtype {dtype!r} is not a numpy dtype; use e.g. 'uint8', 'uint16', 'int16', "
-                         "'int32', 'float32', 'float64'.") from None
-    if dt.kind not in "biuf":
-        raise TypeError(f"{path}: dtype {dt} is not a real number type.")
+    dt = sample_dtype(path, dtype, byteorder, header_bytes)
     if isinstance(shape, (int, np.integer)) or len(tuple(shape)) != 3:
         raise ValueError(f"{path}: shape must be three sample counts (nz, ny, nx), got {shape!r}.")
     shape = tuple(int(s) for s in shape)
     if min(shape) < 1:
         raise ValueError(f"{path}: shape {shape} must be positive on every axis.")
-    marker = dtype[0] if isinstance(dtype, str) and dtype[:1] in ("<", ">") else dt.byteorder
-    explicit = {"<": "little", ">": "big"}.get(marker)
-    if byteorder is not None and byteorder not in ("little", "big"):
-        raise ValueError(f"{path}: byteorder {byteorder!r} is not known; choose 'little' or 'big'.")
-    if explicit and byteorder and explicit != byteorder:
-        raise ValueError(f"{path}: dtype {dtype!r} says {explicit}-endian but byteorder={byteorder!r}.")
-    order = byteorder or explicit
-    if dt.itemsize > 1:
-        if order is None:
-            raise ValueError(f"{path}: {dt.name} samples take {dt.itemsize} bytes; pass byteorder='little' "
-                             "(most files from PCs) or byteorder='big' - a wrong guess reads plausible garbage.")
-        dt = with_byteorder(dt, order)
-    if isinstance(header_bytes, bool) or not isinstance(header_bytes, (int, np.integer)) or header_bytes < 0:
-        raise ValueError(f"{path}: header_bytes must be a non-negative int, got {header_bytes!r}.")
     n = int(np.prod(shape))
     expected = int(header_bytes) + n * dt.itemsize
     actual = path.stat().st_size

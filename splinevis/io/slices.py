@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .raw import with_byteorder
+from .raw import sample_dtype
 from .volume_samples import VolumeSamples, from_array
 
 __all__ = ["read_slices", "natural_key", "is_glob"]
@@ -69,9 +69,12 @@ def read_slices(source, shape, dtype, byteorder, header_bytes, spacing, origin, 
     Returns
     -------
     VolumeSamples
+        The slices stacked along z in natural name order (``s2`` before ``s10``).
 
     Examples
     --------
+    Three slices written out of order come back sorted by the numbers in their names:
+
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     for z in (10, 2, 1):
@@ -89,32 +92,12 @@ def read_slices(source, shape, dtype, byteorder, header_bytes, spacing, origin, 
                          "NRRD or MetaImage first.")
     if component is not None:
         raise ValueError(f"{where}: raw slices hold one value per sample; drop component={component!r}.")
-    try:
-        dt = np.dtype(dtype)
-    except TypeError:
-        raise ValueError(f"{where}: dtype {dtype!r} is not a numpy dtype; use e.g. 'uint8', 'uint16', 'int16', "
-                         "'float32'.") from None
-    if dt.kind not in "biuf":
-        raise TypeError(f"{where}: dtype {dt} is not a real number type.")
+    dt = sample_dtype(where, dtype, byteorder, header_bytes)
     if isinstance(shape, (int, np.integer)) or len(tuple(shape)) not in (2, 3):
         raise ValueError(f"{where}: shape must be the slice size (ny, nx) or (nz, ny, nx), got {shape!r}.")
     shape = tuple(int(s) for s in shape)
     if min(shape) < 1:
         raise ValueError(f"{where}: shape {shape} must be positive on every axis.")
-    marker = dtype[0] if isinstance(dtype, str) and dtype[:1] in ("<", ">") else dt.byteorder
-    explicit = {"<": "little", ">": "big"}.get(marker)
-    if byteorder is not None and byteorder not in ("little", "big"):
-        raise ValueError(f"{where}: byteorder {byteorder!r} is not known; choose 'little' or 'big'.")
-    if explicit and byteorder and explicit != byteorder:
-        raise ValueError(f"{where}: dtype {dtype!r} says {explicit}-endian but byteorder={byteorder!r}.")
-    order = byteorder or explicit
-    if dt.itemsize > 1:
-        if order is None:
-            raise ValueError(f"{where}: {dt.name} samples take {dt.itemsize} bytes; pass byteorder='little' "
-                             "(most files from PCs) or byteorder='big' - a wrong guess reads plausible garbage.")
-        dt = with_byteorder(dt, order)
-    if isinstance(header_bytes, bool) or not isinstance(header_bytes, (int, np.integer)) or header_bytes < 0:
-        raise ValueError(f"{where}: header_bytes must be a non-negative int, got {header_bytes!r}.")
     files = _files(source)
     ny, nx = shape[-2:]
     if len(shape) == 3 and shape[0] != len(files):
