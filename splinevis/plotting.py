@@ -39,12 +39,6 @@ def _style_from(style, style_kwargs) -> Style:
     return style.replace(**style_kwargs) if style_kwargs else style
 
 
-#: Largest |height| (and height span) the terrain program accepts: the GPU computes in float32, whose
-#: largest finite number is 3.4e38; heights are shifted and their differences scaled on the GPU, so the
-#: limit keeps a margin of 1e6 below it.
-HEIGHT_LIMIT = float(np.finfo(np.float32).max) / 1e6
-
-
 def _check_window_size(window_size) -> None:
     """ValueError unless ``window_size`` is two positive ints ``(width, height)``.
 
@@ -61,18 +55,6 @@ def _check_window_size(window_size) -> None:
         raise ValueError(f"window_size={window_size!r} must be two positive pixel counts (width, height), e.g. "
                          "window_size=(800, 600); a zero or negative size would silently render a 300 x 300 "
                          "picture.")
-
-
-def _check_heights_fit_float32(grid) -> None:
-    """ValueError when heights exceed :data:`HEIGHT_LIMIT` (the GPU's float32 would overflow: blank image)."""
-    v = np.asarray(grid.heights, dtype=np.float64)
-    top = float(np.abs(v).max())
-    span = float(v.max() - v.min())
-    if top > HEIGHT_LIMIT or span > HEIGHT_LIMIT:
-        raise ValueError(f"heights: the largest |height| is {top:.6g} (span {span:.6g}), beyond the limit "
-                         f"{HEIGHT_LIMIT:.3g} the GPU program can take (it computes in float32, max 3.4e38; "
-                         "the limit keeps a margin for its arithmetic), so the picture would be blank. Rescale "
-                         "the heights (e.g. heights / 1e300, or other units) before add_terrain.")
 
 
 class Plotter(pv.Plotter):
@@ -191,14 +173,6 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
-        from .io import read_heights
-        from .programs import get
-
-        if not isinstance(heights, get("terrain").model_type) and not hasattr(heights, "crs"):
-            heights = read_heights(heights, **(read_options or {}))  # raw data: read here to check the range
-            read_options = None
-        if hasattr(heights, "crs"):  # a HeightGrid (duck-typed: plotting names no family types)
-            _check_heights_fit_float32(heights)
         return self._add_from("terrain", (heights, scheme, presmooth), read_options, style, options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,

@@ -11,7 +11,7 @@ import pytest
 
 import splinevis
 from splinevis.cli import main
-from splinevis.plotting import HEIGHT_LIMIT
+from splinevis.terrain.limits import HEIGHT_LIMIT
 
 
 @pytest.mark.parametrize("size", [(0, 0), (-5, 10), (10,), (1.5, 20), "big", (True, 10)])

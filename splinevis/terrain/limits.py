@@ -7,9 +7,34 @@ branches for :data:`MAX_TABLE_TEXTURES` of them: 33.5M cells, e.g. 5792 x 5792 o
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..gl.proxies import MAX_TEXTURE_ROWS, ROWS_PER_TEXTURE, TEXTURE_WIDTH
 
-__all__ = ["MAX_TABLE_TEXTURES", "check_grid_size"]
+__all__ = ["MAX_TABLE_TEXTURES", "HEIGHT_LIMIT", "check_grid_size", "check_height_range"]
+
+#: Largest |height| (and height span) the terrain program accepts: the GPU computes in float32, whose
+#: largest finite number is 3.4e38; heights are shifted and their differences scaled on the GPU, so the
+#: limit keeps a margin of 1e6 below it.
+HEIGHT_LIMIT = float(np.finfo(np.float32).max) / 1e6
+
+
+def check_height_range(heights) -> None:
+    """ValueError when heights exceed :data:`HEIGHT_LIMIT` (the GPU's float32 would overflow: a blank image).
+
+    >>> check_height_range(np.array([[0.0, 1e300]]))
+    Traceback (most recent call last):
+    ...
+    ValueError: heights: the largest |height| is 1e+300 (span 1e+300), beyond the limit 3.4e+32 the GPU program can take (it computes in float32, max 3.4e38; the limit keeps a margin for its arithmetic), so the picture would be blank. Rescale the heights (e.g. heights / 1e300, or other units) before building the terrain.
+    """
+    v = np.asarray(heights, dtype=np.float64)
+    top = float(np.abs(v).max())
+    span = float(v.max() - v.min())
+    if top > HEIGHT_LIMIT or span > HEIGHT_LIMIT:
+        raise ValueError(f"heights: the largest |height| is {top:.6g} (span {span:.6g}), beyond the limit "
+                         f"{HEIGHT_LIMIT:.3g} the GPU program can take (it computes in float32, max 3.4e38; "
+                         "the limit keeps a margin for its arithmetic), so the picture would be blank. Rescale "
+                         "the heights (e.g. heights / 1e300, or other units) before building the terrain.")
 
 #: Textures a split coefficient table may use (the shader's branches).
 MAX_TABLE_TEXTURES = 4

@@ -137,6 +137,9 @@ class TerrainSpline:
 
             grid = smooth_heights(grid, presmooth)
         z = np.asarray(grid.heights, dtype=np.float64)
+        from .limits import check_grid_size, check_height_range
+
+        check_height_range(z)  # before anything is built: float32 on the GPU would overflow
         spacing = grid.spacing
         source = grid.source
         if scheme == "C0" and ((z.shape[0] - 1) % 4 or (z.shape[1] - 1) % 4) and min(z.shape) >= 4:
@@ -148,8 +151,6 @@ class TerrainSpline:
             z, (sx, sy) = resample_for_c0(z)
             spacing = (spacing[0] * sx, spacing[1] * sy)
             source = f"{source} (resampled from {shape[1]}x{shape[0]} to {z.shape[1]}x{z.shape[0]} samples for C0)"
-        from .limits import check_grid_size
-
         cell = 4 if scheme == "C0" else 1  # samples per spline cell
         check_grid_size(max(1, (z.shape[1] - 1) // cell), max(1, (z.shape[0] - 1) // cell))  # before building
         z_ref = float(np.mean(z))
