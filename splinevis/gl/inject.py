@@ -262,7 +262,7 @@ class SplineActor:
         self.actor = actor
         self.rotation = None  # world-from-model rotation (None: the identity; see set_frame)
         self.position = self.offset
-        if getattr(spec, "world_frame", None) is not None:  # (rotation, pivot) of a rotated lattice
+        if spec.world_frame is not None:  # (rotation, pivot) of a rotated lattice
             self.set_frame(*spec.world_frame)
         prop = actor.GetProperty()
         if kind not in _FS_IMPL:

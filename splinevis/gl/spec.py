@@ -40,6 +40,9 @@ class ProgramSpec:
         cube to float32 precision whatever the volume's size.
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    world_frame : (rotation (3, 3), pivot (3,)) or None
+        For a model drawn in a rotated frame (a volume on a rotated orthogonal lattice): the actor maps model
+        coordinates into the world by this rotation about ``pivot`` (:meth:`SplineActor.set_frame`).
     glsl_roots : tuple of Path, optional
         Folders searched for GLSL files before the shipped ``glsl/`` (a family outside the package keeps its
         program file there; ``entry`` is then relative to such a folder).
@@ -69,3 +72,4 @@ class ProgramSpec:
     frame_uniforms: Callable | None = None
     offset: tuple = (0.0, 0.0, 0.0)
     glsl_roots: tuple = ()
+    world_frame: tuple | None = None

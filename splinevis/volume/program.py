@@ -130,7 +130,7 @@ def isosurface_program(model: Isosurface, style=None, *, newton_iterations: int 
 
         textures["sv_color_data"] = pack_rgba32f(_pad(values), name="color_field texture")
         scalar_range = (float(values.min()), float(values.max()))
-    spec = ProgramSpec(
+    return ProgramSpec(
         name="isosurface",
         entry="programs/isosurface.glsl",
         points=points,
@@ -155,11 +155,8 @@ def isosurface_program(model: Isosurface, style=None, *, newton_iterations: int 
         textures=textures,
         attributes=attributes,
         varyings=varyings,
+        world_frame=world_frame(spline),  # a rotated lattice: the actor draws the lattice frame rotated into the world
     )
-    frame = world_frame(spline)
-    if frame is not None:  # a rotated lattice: the actor draws the lattice frame rotated into the world
-        object.__setattr__(spec, "world_frame", frame)
-    return spec
 
 
 def set_isovalue(actor, isovalue: float) -> Relevant:
