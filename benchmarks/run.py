@@ -189,44 +189,49 @@ def bench_volume(repeats, quick):
     return rows
 
 
+def _section(lines, results, case, title, columns, row):
+    """One markdown table per benchmark case present in ``results``: ``columns`` as (header, alignment) pairs,
+    ``row(r)`` the cells of one result."""
+    if case not in results:
+        return
+    lines.append(f"\n## {title}\n")
+    lines.append("| " + " | ".join(h for h, _ in columns) + " |")
+    lines.append("|" + "|".join("---:" if right else "---" for _, right in columns) + "|")
+    lines.extend("| " + " | ".join(row(r)) + " |" for r in results[case])
+
+
 def _markdown(results):
-    lines = [f"# splinevis benchmarks\n\n{results['machine']}\n"]
-    if "raycast_vs_mesh" in results:
-        lines.append(f"## Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)\n")
-        lines.append("| renderer | triangles | min ms | median ms | median / ray-cast |")
-        lines.append("|---|---:|---:|---:|---:|")
-    for r in results.get("raycast_vs_mesh", []):
-        lines.append(f"| {r['renderer']} | {r['triangles']:,} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_raycast']:.2f} |")
-    if "effect_sets" in results:
-        lines.append("\n## Effect sets on the ray-cast patch\n")
-        lines.append("| effect set | compiled effects | min ms | median ms | median / unlit |")
-        lines.append("|---|---|---:|---:|---:|")
-    for r in results.get("effect_sets", []):
-        lines.append(f"| {r['effect_set']} | {', '.join(r['effects']) or '-'} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_unlit']:.2f} |")
-    for r in results.get("large_terrain", []):
-        lines.append("\n## Large terrain (own process)\n")
-        lines.append("| grid | patches | construction s | program + first frame s | frame median ms | covered | peak MB |")
-        lines.append("|---|---:|---:|---:|---:|---:|---:|")
-        lines.append(f"| {r['grid']} | {r['patches']:,} | {r['construction_s']:.1f} | {r['program_and_first_frame_s']:.1f} | "
-                     f"{r['frame_median_ms']:.0f} | {r['screen_covered']:.2f} | {r['peak_MB']:.0f} |")
-    for r in results.get("cold_start", []):
-        lines.append("\n## Cold start (new process, median)\n")
-        lines.append("| import s | C1 terrain 65^2 + quadratic and cubic volume 16^3 s | first terrain picture s |")
-        lines.append("|---:|---:|---:|")
-        lines.append(f"| {r['import_s']:.2f} | {r['models_s']:.2f} | {r['first_picture_s']:.2f} |")
-    if "terrain" in results:
-        lines.append("\n## Terrain ray casting: grid size and hierarchy (same full-screen oblique view)\n")
-        lines.append("| grid | patches | hierarchy | screen covered | min ms | median ms | median / 65x65 |")
-        lines.append("|---|---:|---|---:|---:|---:|---:|")
-    for r in results.get("terrain", []):
-        lines.append(f"| {r['grid']} | {r['patches']:,} | {'min/max quadtree' if r['hierarchy'] else 'off (cell walk)'} | "
-                     f"{r['screen_covered']:.2f} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_smallest_grid']:.2f} |")
-    if "volume" in results:
-        lines.append("\n## Volume isosurfaces: Marschner-Lobb 64^3 (same data, same views)\n")
-        lines.append("| view | program | min ms | median ms | median / marching cubes |")
-        lines.append("|---|---|---:|---:|---:|")
-        for r in results["volume"]:
-            lines.append(f"| {r['view']} | {r['program']} | {r['min_ms']:.1f} | {r['median_ms']:.1f} | {r['ratio_to_mesh']:.1f} |")
+    lines = [f"# splinevis benchmarks\n\n{results['machine']}"]
+    num, text = True, False
+    _section(lines, results, "raycast_vs_mesh", f"Ray-cast patch vs PyVista meshes ({WINDOW[0]}x{WINDOW[1]}, AA off)",
+             [("renderer", text), ("triangles", num), ("min ms", num), ("median ms", num), ("median / ray-cast", num)],
+             lambda r: [r["renderer"], f"{r['triangles']:,}", f"{r['min_ms']:.1f}", f"{r['median_ms']:.1f}",
+                        f"{r['ratio_to_raycast']:.2f}"])
+    _section(lines, results, "effect_sets", "Effect sets on the ray-cast patch",
+             [("effect set", text), ("compiled effects", text), ("min ms", num), ("median ms", num),
+              ("median / unlit", num)],
+             lambda r: [r["effect_set"], ", ".join(r["effects"]) or "-", f"{r['min_ms']:.1f}", f"{r['median_ms']:.1f}",
+                        f"{r['ratio_to_unlit']:.2f}"])
+    _section(lines, results, "large_terrain", "Large terrain (own process)",
+             [("grid", text), ("patches", num), ("construction s", num), ("program + first frame s", num),
+              ("frame median ms", num), ("covered", num), ("peak MB", num)],
+             lambda r: [r["grid"], f"{r['patches']:,}", f"{r['construction_s']:.1f}",
+                        f"{r['program_and_first_frame_s']:.1f}", f"{r['frame_median_ms']:.0f}",
+                        f"{r['screen_covered']:.2f}", f"{r['peak_MB']:.0f}"])
+    _section(lines, results, "cold_start", "Cold start (new process, median)",
+             [("import s", num), ("C1 terrain 65^2 + quadratic and cubic volume 16^3 s", num),
+              ("first terrain picture s", num)],
+             lambda r: [f"{r['import_s']:.2f}", f"{r['models_s']:.2f}", f"{r['first_picture_s']:.2f}"])
+    _section(lines, results, "terrain", "Terrain ray casting: grid size and hierarchy (same full-screen oblique view)",
+             [("grid", text), ("patches", num), ("hierarchy", text), ("screen covered", num), ("min ms", num),
+              ("median ms", num), ("median / 65x65", num)],
+             lambda r: [r["grid"], f"{r['patches']:,}", "min/max quadtree" if r["hierarchy"] else "off (cell walk)",
+                        f"{r['screen_covered']:.2f}", f"{r['min_ms']:.1f}", f"{r['median_ms']:.1f}",
+                        f"{r['ratio_to_smallest_grid']:.2f}"])
+    _section(lines, results, "volume", "Volume isosurfaces: Marschner-Lobb 64^3 (same data, same views)",
+             [("view", text), ("program", text), ("min ms", num), ("median ms", num), ("median / marching cubes", num)],
+             lambda r: [r["view"], r["program"], f"{r['min_ms']:.1f}", f"{r['median_ms']:.1f}",
+                        f"{r['ratio_to_mesh']:.1f}"])
     return "\n".join(lines) + "\n"
 
 
