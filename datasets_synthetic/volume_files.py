@@ -143,11 +143,7 @@ def write_volume(grid: VolumeGrid, path, *, dtype=None, byteorder="little", dire
                 f"ElementSpacing = {' '.join(map(_num, grid.spacing))}\n"
                 f"DimSize = {nx} {ny} {nz}\nElementType = {_MET[data.dtype.name]}\n"
                 f"ElementDataFile = {path.stem + '.raw' if detached else 'LOCAL'}\n")
-        if detached:
-            path.write_text(head)
-            path.with_suffix(".raw").write_bytes(body)
-        else:
-            path.write_bytes(head.encode() + body)
+        _write_header(path, head, body, detached)
         return {}
     # NRRD
     import gzip
@@ -161,12 +157,18 @@ def write_volume(grid: VolumeGrid, path, *, dtype=None, byteorder="little", dire
             + (f"endian: {byteorder}\n" if data.dtype.itemsize > 1 else "")
             + f"encoding: {'gzip' if compress else 'raw'}\n"
             + (f"data file: {path.stem}.raw\n" if detached else "") + "\n")
+    _write_header(path, head, body, detached)
+    return {}
+
+
+def _write_header(path: Path, head: str, body: bytes, detached: bool) -> None:
+    """A text header followed by the samples in one file, or (``detached``: .mhd, .nhdr) the header alone
+    beside a ``.raw`` file of the samples."""
     if detached:
         path.write_text(head)
         path.with_suffix(".raw").write_bytes(body)
     else:
         path.write_bytes(head.encode() + body)
-    return {}
 
 
 def write_cube(grid: VolumeGrid, path, *, direction=None, atoms=((8, 0.0, 0.0, 0.0, 0.0),), per_line=6,
