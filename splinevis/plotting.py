@@ -187,7 +187,7 @@ class Plotter(pv.Plotter):
         (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
         :meth:`add_spline`). An isovalue outside the data's range (an empty isosurface) raises ValueError
         giving the range. A volume on a rotated orthogonal lattice (``VolumeGrid.direction``, e.g. a Gaussian
-        cube file) is drawn in its true frame (the actor's user matrix; no culling then). Returns the
+        cube file) is drawn in its true frame (the actor's user matrix; culled in its lattice frame). Returns the
         :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.isosurface.Isosurface`.
 
         Examples

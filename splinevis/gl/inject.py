@@ -230,6 +230,8 @@ class SplineActor:
         self.renderer = renderer
         defines = dict(spec.defines)
         defines.update(style.defines())
+        if spec.world_frame is not None:  # world-frame effects (normal colours, environment) need the rotation
+            defines["SV_MODEL_ROTATED"] = 1
         entry = "".join(f'#include "{f}"\n' for f in style.include_files())
         entry += '#include "lib/core/shading.glsl"\n' + f'#include "{spec.entry}"\n'
         # Effect functions must precede lib/core/shading.glsl which calls them; lib/core/raycast.glsl (SvHit)
@@ -431,6 +433,9 @@ class SplineActor:
                 m.SetElement(i, j, float(R[i, j]))
             m.SetElement(i, 3, float(shift[i]))
         self.actor.SetUserMatrix(m)
+        culler = getattr(self, "culler", None)  # a frustum culler attached before keeps up with the frame
+        if culler is not None:
+            culler.offset, culler.rotation = self.position.copy(), R
 
     def camera_frame(self):
         """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera.
@@ -506,6 +511,8 @@ class SplineActor:
         u.update(self.style.uniforms())
         if self.style.texture is not None:
             u["sv_texture_map"] = self._texture_map()
+        if self.rotation is not None and self.spec.world_frame is not None:
+            u["sv_world_from_model[]"] = self.rotation
         u.update(self.extra_uniforms)
         return u
 

@@ -6,6 +6,11 @@ against the camera's six frustum planes from the root down [Kalbe2008, sec. 5.1]
 plane is dropped with its subtree, a node entirely inside all planes keeps its whole subtree without further
 tests, and the rest descend. A node's box encloses its cells, so the float64 test is conservative: culling
 never removes a visible pixel. ``on_change`` gets the visible units only when the set changes.
+
+The grid may sit in the world rotated (a volume on a rotated lattice): with ``rotation`` R the world point of
+a model point p is ``offset + R p``, and the planes are mapped into the model frame (a plane ``n . w + d >= 0``
+becomes ``(R^T n) . p + d + n . offset >= 0``), so the boxes are still tested axis-aligned in their own frame;
+a rigid motion keeps the test exact.
 """
 
 from __future__ import annotations
@@ -43,6 +48,8 @@ class FrustumCuller:
     min_level : int
     offset : (3,) array_like
         World position of the model frame's origin.
+    rotation : (3, 3) array_like, optional
+        World-from-model rotation (orthonormal): world = ``offset + rotation @ p``; None for the identity.
     on_change : callable
         ``on_change(visible)`` with a boolean mask over ``units``.
 
@@ -62,10 +69,16 @@ class FrustumCuller:
     """
 
     def __init__(self, units, *, spacing, origin=(0.0, 0.0, 0.0), level=None, grid_shape=None, min_level=0,
-                 offset=(0.0, 0.0, 0.0), on_change=None):
+                 offset=(0.0, 0.0, 0.0), rotation=None, on_change=None):
         self.spacing = np.asarray(spacing, dtype=np.float64).reshape(3)
         self.origin = np.asarray(origin, dtype=np.float64).reshape(3)
         self.offset = np.asarray(offset, dtype=np.float64).reshape(3)
+        self.rotation = None
+        if rotation is not None:
+            R = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
+            if np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
+                raise ValueError(f"rotation must be orthonormal (a rigid motion), got {R.tolist()}.")
+            self.rotation = R
         if level is None:
             level = default_level(grid_shape) if grid_shape is not None else 0
         self.level = max(int(level), int(min_level))
@@ -153,8 +166,24 @@ class FrustumCuller:
         blocks = self.visible_blocks(planes)
         return blocks[self.unit_block] if len(self.unit_block) else np.zeros(0, bool)
 
+    def model_planes(self, world_planes) -> np.ndarray:
+        """World planes (6, 4) mapped into the model frame (world = ``offset + rotation @ p``).
+
+        Examples
+        --------
+        >>> quarter_turn = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]  # model +x is world +y
+        >>> c = FrustumCuller([[0, 0, 0]], spacing=(1, 1, 1), offset=(0, 5, 0), rotation=quarter_turn)
+        >>> c.model_planes(np.array([[0.0, 1.0, 0.0, -7.0]])).tolist()  # world y >= 7: model x >= 2
+        [[1.0, 0.0, 0.0, -2.0]]
+        """
+        P = np.array(world_planes, dtype=np.float64).reshape(-1, 4)
+        P[:, 3] += P[:, :3] @ self.offset  # n . (offset + R p) + d
+        if self.rotation is not None:
+            P[:, :3] = P[:, :3] @ self.rotation  # rows n^T R = (R^T n)^T
+        return P
+
     def frustum_planes(self, renderer) -> np.ndarray:
-        """The renderer's active camera's six planes in the model frame.
+        """The renderer's active camera's six planes in the model frame (:meth:`model_planes`).
 
         Examples
         --------
@@ -170,9 +199,7 @@ class FrustumCuller:
         w, h = renderer.GetSize()
         planes = [0.0] * 24
         cam.GetFrustumPlanes(w / max(h, 1), planes)
-        P = np.array(planes, dtype=np.float64).reshape(6, 4)
-        P[:, 3] += P[:, :3] @ self.offset  # world = model + offset
-        return P
+        return self.model_planes(planes)
 
     def update(self, renderer) -> None:
         """Cull for the renderer's current camera; calls ``on_change`` when the visible set changed.

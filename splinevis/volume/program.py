@@ -284,17 +284,41 @@ def _lattice_rays(model, origins, directions):
 
 
 def raycast_world(model: Isosurface, origins, directions, tmin=0.0, **options):
-    """:func:`~splinevis.volume.raycast.raycast_isosurface` on WORLD rays: for a volume on a rotated lattice
-    the rays are first mapped into the lattice frame (``t`` is the same: the map is a rigid motion).
+    """:func:`~splinevis.volume.raycast.raycast_isosurface` on WORLD rays, with world results: for a volume
+    on a rotated lattice the rays are mapped into the lattice frame, cast there, and the hits come back in
+    the world (``t`` is the same: the map is a rigid motion; points = ``pivot + R (p - pivot)``, i.e. the
+    world ray at ``t``; normals = ``R n``).
 
     >>> from splinevis.volume.hard_cases import sphere_grid
     >>> surface = Isosurface(VolumeSpline(sphere_grid(12)), 0.7)
     >>> float(raycast_world(surface, [[0.0, 0.0, 3.0]], [[0.0, 0.0, -1.0]]).t[0]) == float(
     ...     raycast_isosurface(surface, [[0.0, 0.0, 3.0]], [[0.0, 0.0, -1.0]]).t[0])
     True
+
+    A quarter turn about z (pivot at the grid origin, the centre of the sphere's lattice is moved): the
+    ray along world -y meets the sphere where the lattice ray along -x does; points and normals are world.
+
+    >>> from splinevis.io import VolumeGrid
+    >>> g = sphere_grid(12)
+    >>> turn = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]  # lattice +x is world +y
+    >>> turned = Isosurface(VolumeSpline(VolumeGrid(g.values, spacing=g.spacing, origin=g.origin,
+    ...                                             direction=turn)), 0.7)
+    >>> pivot = np.array(g.origin)
+    >>> centre = pivot + np.array(turn) @ (0.0 - pivot)  # the world image of the lattice point 0
+    >>> h = raycast_world(turned, [centre + [0.0, 3.0, 0.0]], [[0.0, -1.0, 0.0]])
+    >>> ((h.points[0] - centre).round(3) + 0.0).tolist(), (h.normals[0] / np.linalg.norm(h.normals[0])).round(6).tolist()
+    ([0.0, 0.688, 0.0], [0.0, 1.0, 0.0])
     """
     o, d = _lattice_rays(model, origins, directions)
-    return raycast_isosurface(model, o, d, tmin, **options)
+    hits = raycast_isosurface(model, o, d, tmin, **options)
+    frame = world_frame(model.spline)
+    if frame is None:
+        return hits
+    R = frame[0]
+    ow, dw = np.broadcast_arrays(np.asarray(origins, dtype=np.float64), np.asarray(directions, dtype=np.float64))
+    hits.points = ow + hits.t[..., None] * dw  # the world ray at t: pivot + R (p - pivot) without its round-off
+    hits.normals = hits.normals @ R.T  # R n (row vectors)
+    return hits
 
 
 def check_isovalue_in_range(surface: Isosurface, what: str = "isovalue") -> None:
@@ -320,7 +344,9 @@ def check_isovalue_in_range(surface: Isosurface, what: str = "isovalue") -> None
 def attach_culling(actor, plotter, *, culling: bool = True) -> None:
     """Hierarchical view-frustum culling of the proxies before every frame (``actor.culler``): blocks of
     2^theta cubes tested against the camera's planes by the octree over them
-    (:class:`splinevis.hierarchy.FrustumCuller`); images with and without are identical (tested).
+    (:class:`splinevis.hierarchy.FrustumCuller`); images with and without are identical (tested). A volume
+    on a rotated lattice is culled in its lattice frame: the culler gets the actor's rigid motion and maps the
+    camera's planes into that frame (the blocks stay axis-aligned there).
 
     Examples
     --------
@@ -340,8 +366,8 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
     (0, 0)
     >>> pl.close()
     """
-    if not culling or world_frame(actor.model.spline) is not None:
-        return  # the culler tests axis-aligned blocks in the world: not for a rotated lattice (drawn whole)
+    if not culling:
+        return
     spec, model = actor.spec, actor.model
     blocks = bool(spec.defines.get("SV_VOLUME_BLOCKS"))
     B = int(spec.uniforms.get("sv_block_size", BLOCK_SIZE)) if blocks else 1
@@ -353,7 +379,8 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
 
     # a culling node must enclose every proxy box assigned to it: theta >= log2(block size)
     actor.culler = FrustumCuller(units, spacing=spacing, origin=-0.5 * spacing, grid_shape=model.spline.shape,
-                                 min_level=int(np.ceil(np.log2(B))), offset=actor.offset, on_change=show)
+                                 min_level=int(np.ceil(np.log2(B))), offset=actor.position, rotation=actor.rotation,
+                                 on_change=show)
     actor.culler.attach(plotter.renderer)
 
 

@@ -2,11 +2,22 @@
 // lib/effects/, which the Python side includes only when the scene's Style declares the effect
 // (splinevis/effects.py). Nothing here refers to an effect's function unless its flag is defined.
 
+#ifdef SV_MODEL_ROTATED
+// A model drawn rotated (a volume on a rotated lattice): the ray cast works in the model frame, while the
+// normal colours, the environment (z up) and the reflection lines are world-frame pictures.
+uniform vec3 sv_world_from_model[3];  // rows of the rotation
+vec3 sv_to_world(vec3 v) {
+    return vec3(dot(sv_world_from_model[0], v), dot(sv_world_from_model[1], v), dot(sv_world_from_model[2], v));
+}
+#else
+#define sv_to_world(v) (v)
+#endif
+
 vec4 sv_shade(SvHit h, vec3 rd) {
     vec3 n = normalize(h.normal);
     if (dot(n, rd) > 0.0) n = -n;  // two-sided: the normal faces the viewer
 #if defined(SV_OUT_NORMALS)
-    return vec4(sv_normal_color(n), 1.0);
+    return vec4(sv_normal_color(sv_to_world(n)), 1.0);
 #elif defined(SV_OUT_CURVATURE)
     return vec4(sv_curvature_color(h.curvature), 1.0);
 #elif defined(SV_OUT_DEPTH)
@@ -24,10 +35,10 @@ vec4 sv_shade(SvHit h, vec3 rd) {
     col = sv_lights(n, -rd, base);
 #endif
 #ifdef SV_ENVIRONMENT
-    col = mix(col, sv_environment(reflect(rd, n)), 0.4);
+    col = mix(col, sv_environment(sv_to_world(reflect(rd, n))), 0.4);
 #endif
 #ifdef SV_REFLECTION_LINES
-    col *= sv_reflection_lines(reflect(rd, n));
+    col *= sv_reflection_lines(sv_to_world(reflect(rd, n)));
 #endif
 #ifdef SV_ISOPHOTES
     col *= sv_isophotes(n);
