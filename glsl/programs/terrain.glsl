@@ -157,8 +157,21 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             float margin = max(SV_CELL_MARGIN, 4.76837158203125e-07 * (max(abs(P0.x), abs(P0.y))
                                                                       + abs(t) * max(abs(D.x), abs(D.y))));
             float dt_margin = margin / max(max(abs(D.x), abs(D.y)), 1e-30);
-            float h0 = sv_triangle_hit(b0, 0, o, D, t - dt_margin, tb + dt_margin, margin);
-            float h1 = sv_triangle_hit(b1, 1, o, D, t - dt_margin, tb + dt_margin, margin);
+            float ta_c = t - dt_margin;
+            float tb_c = tb + dt_margin;
+            // A (nearly) vertical ray crosses no cell edge: margin / |D.xy| is then astronomically large and the
+            // segment's start, o + ta d, would lie ~1e25 away (the root's t lost to rounding: a parallel top
+            // view drew every pixel at one depth). Its roots lie where the ray is within the cell's height
+            // range, so the segment is cut to that slab, padded by its own height and the ray's rounding.
+            if (abs(D.z) > 0.0) {
+                float zpad = (mm.y - mm.x) + zerr + 1.0e-6 * (abs(mm.x) + abs(mm.y)) + 1.0e-30;
+                float tz0 = (mm.x - zpad - P0.z) / D.z;
+                float tz1 = (mm.y + zpad - P0.z) / D.z;
+                ta_c = max(ta_c, min(tz0, tz1));
+                tb_c = min(tb_c, max(tz0, tz1));
+            }
+            float h0 = sv_triangle_hit(b0, 0, o, D, ta_c, tb_c, margin);
+            float h1 = sv_triangle_hit(b1, 1, o, D, ta_c, tb_c, margin);
             float th = min(h0, h1);
             if (th < SV_NO_HIT) {
                 t_hit = th;

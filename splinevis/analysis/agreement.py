@@ -110,8 +110,16 @@ def hard_case_agreement(case) -> dict:
     []
     """
     model = case.model()
-    clip = case.clipping_range
-    hook = None if clip is None else (lambda pl: setattr(pl.camera, "clipping_range", clip))
+    clip, scale = case.clipping_range, case.parallel_scale
+
+    def hook(pl):
+        if scale is not None:
+            pl.camera.parallel_projection = True
+            pl.camera.parallel_scale = scale
+            pl.reset_camera_clipping_range()
+        if clip is not None:
+            pl.camera.clipping_range = clip
+
     return depth_agreement(model, case.camera_for(model), case.window_size, newton_iterations=case.newton_iterations,
                            plotter_hook=hook, program_options=case.program_options)
 

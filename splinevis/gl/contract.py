@@ -107,6 +107,8 @@ class HardCase:
         Largest fraction of pixels where exactly one side hits (silhouettes grazed within rounding).
     min_hits : float
         Smallest fraction of pixels where both hit: a case that shows (almost) nothing tests nothing.
+    parallel_scale : float or None
+        A parallel projection with this half height of the view (world units); None: perspective.
 
     Examples
     --------
@@ -125,6 +127,7 @@ class HardCase:
     depth_fraction: float = 0.999
     max_disagree: float = 0.001
     min_hits: float = 0.02
+    parallel_scale: float | None = None
 
     def camera_for(self, model) -> list:
         """The camera position for ``model``.

@@ -1,6 +1,7 @@
 """USGS ASCII DEM files (``.dem``): type A header and type B profiles parsed here.
 
-Why our own parser and not ``vtkDEMReader`` (nor GDAL's USGSDEM driver, not wired in yet):
+Why our own parser and not ``vtkDEMReader`` nor GDAL's USGSDEM driver (through rasterio, which reads
+every other raster, :mod:`.raster`):
 
 * The type A header is parsed in float64 (corners D24.15: 16 significant digits; resolution E12.6:
   7 significant digits); ``vtkDEMReader`` works in float32 and applies its own unit factors.
@@ -10,6 +11,18 @@ Why our own parser and not ``vtkDEMReader`` (nor GDAL's USGSDEM driver, not wire
   7.5-minute DEMs) land rows off and uncovered nodes get the file minimum; it also accepts truncated
   files. So the profiles are parsed here: each placed by its own start, uncovered nodes missing (the
   gap logic of :func:`read_heights` reports or fills them), truncated files a ValueError.
+* GDAL 3.10's USGSDEM driver (measured on files of
+  :func:`datasets_synthetic.dem_files.write_usgs_ascii_dem` with known sample positions) places
+  clipped profiles right, marks uncovered nodes nodata and fails the read of a truncated file, but:
+
+  - it snaps the raster to multiples of the spacing: with 30 m samples starting at
+    (500010, 5100020) every sample is read 10 m north of its true position (the northing is not a
+    multiple of 30), and the raster gains a row of nodata;
+  - it cannot read elevations whose I6 fields touch (six-digit integers such as 100000 = 1000 m at
+    z resolution 0.01, valid in the format): the read fails ("IReadBlock failed");
+  - it returns float32, so heights are not exactly the stored integers times the z resolution.
+
+  ``tests/test_io_heights.py`` checks that our parser reads those files at their true positions.
 """
 
 from __future__ import annotations

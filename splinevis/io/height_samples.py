@@ -1,7 +1,7 @@
 """Height samples as a source stores them, before gaps and orientation are dealt with.
 
 Every height reader (numpy arrays here, pyvista grids in :mod:`.height_vtk`, USGS DEMs in :mod:`.dem`,
-GeoTIFFs in :mod:`.geotiff`) hands a :class:`HeightSamples` to :func:`splinevis.io.read_heights`, which
+rasters through GDAL in :mod:`.raster`) hands a :class:`HeightSamples` to :func:`splinevis.io.read_heights`, which
 reports or fills the gaps, reorients the rows to south-to-north and returns a
 :class:`~splinevis.io.HeightGrid`. Keeping the stored order until then lets the error messages count
 rows and columns as the source stores them.
@@ -18,7 +18,7 @@ from ._common import check_real_dtype
 __all__ = ["HeightSamples", "GEOMETRY_ARGS_APPLY_TO", "from_array", "missing_mask"]
 
 #: The sources ``spacing=``/``origin=`` are meant for (the others carry their own geometry).
-GEOMETRY_ARGS_APPLY_TO = "numpy arrays and TIFFs without georeferencing"
+GEOMETRY_ARGS_APPLY_TO = "numpy arrays and rasters without georeference"
 
 
 @dataclass

@@ -6,22 +6,25 @@
 * a pyvista ``ImageData`` (or ``vtkImageData``) that is one x-y slice, ``dims == (nx, ny, 1)``,
 * a pyvista ``RectilinearGrid`` or ``StructuredGrid`` whose x, y coordinates form an axis-aligned lattice,
 * a file: ``.vti .vtk .vtr .vts`` (through :func:`pyvista.read`), ``.dem`` (USGS ASCII DEM, our own
-  parser: see :mod:`.dem`) and ``.tif .tiff`` (GeoTIFF, through the optional package ``tifffile``).
+  parser: see :mod:`.dem` for what GDAL's driver gets wrong) and, through rasterio/GDAL (see
+  :mod:`.raster`), ``.tif .tiff`` (GeoTIFF/COG), ``.hgt`` (SRTM), ``.asc`` (ESRI ASCII grid), ``.img``,
+  ``.bil``, ``.dt0 .dt1 .dt2`` (DTED), ``.grd``, ``.vrt``; a file with any other extension is tried
+  with GDAL too.
 
 This module holds the result and the dispatch; the readers live in :mod:`.height_vtk` (pyvista grids
-and VTK files), :mod:`.dem` and :mod:`.geotiff`, each with its format notes; gap filling and resampling
+and VTK files), :mod:`.dem` and :mod:`.raster`, each with its format notes; gap filling and resampling
 in :mod:`.height_interp`.
 
 Conventions kept by every reader
 --------------------------------
 * ``heights[j, i]`` is the height at ``(x0 + i*dx, y0 + j*dy)``: **rows run south to north** (y
-  increasing). GeoTIFF files store the northern row first and are flipped; the error messages still
-  count rows and columns as the file stores them.
+  increasing). North-up rasters (GeoTIFF, ...) store the northern row first and are flipped; the error
+  messages still count rows and columns as the file stores them.
 * ``spacing`` may differ in x and y, and the origin is kept in float64 (UTM coordinates such as
   ``(5e5, 5.1e6)`` stay exact). A source that carries its own spacing/origin refuses ``spacing=`` and
   ``origin=`` arguments instead of silently overriding or dropping either.
-* Missing samples (NaN, +-inf, the ``nodata`` value, the GeoTIFF ``GDAL_NODATA`` tag, the DEM void
-  value -32767) raise a ValueError by default, naming the first one by (row, col) and (x, y).
+* Missing samples (NaN, +-inf, the ``nodata`` value, a raster band's nodata value or mask, the DEM
+  void value -32767) raise a ValueError by default, naming the first one by (row, col) and (x, y).
   ``fill="nearest"`` or ``fill="linear"`` fills them (nearest valid sample in world distance, or
   linear interpolation that reproduces a plane).
 * Non-uniform coordinates (RectilinearGrid, StructuredGrid) raise a ValueError naming the largest
@@ -45,19 +48,18 @@ from ._common import (VTK_FILES, check_geometry, first_gap, freeze_grid, gap_err
                       refuse_own_geometry, require_regular_file, source_kind, step_deviation,
                       unsupported_extension)
 from .dem import read_dem
-from .geotiff import read_geotiff
 from .height_interp import fill_gaps, resample_uniform
 from .height_samples import GEOMETRY_ARGS_APPLY_TO, HeightSamples, from_array
 from .height_vtk import from_pyvista, read_vtk_file
+from .raster import RASTER_EXTENSIONS, RasterOpenError, read_raster
 
 __all__ = ["HeightGrid", "read_heights", "SUPPORTED_EXTENSIONS"]
 
-_TIFF_EXTENSIONS = (".tif", ".tiff")
-#: File name extensions :func:`read_heights` reads, and by what.
+#: File name extensions :func:`read_heights` reads, and by what (any other extension is tried with GDAL).
 SUPPORTED_EXTENSIONS = {
     **{ext: f"{kind} (pyvista.read)" for ext, kind in VTK_FILES.items()},
     ".dem": "USGS ASCII DEM (own parser)",
-    **dict.fromkeys(_TIFF_EXTENSIONS, "GeoTIFF (tifffile)"),
+    **{ext: f"{kind} (rasterio/GDAL)" for ext, kind in RASTER_EXTENSIONS.items()},
 }
 
 _FILL_CHOICES = {"nearest", "linear"}
@@ -171,26 +173,38 @@ class HeightGrid:
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None, fill=None,
-                 resample=False) -> HeightGrid:
+                 resample=False, band=1, crs=None, keep_geographic=False, reproject="bilinear") -> HeightGrid:
     """Read height data into a :class:`HeightGrid`.
 
     Parameters
     ----------
     source : (ny, nx) array_like, pyvista.ImageData, pyvista.RectilinearGrid, pyvista.StructuredGrid, str or Path
-        The heights. A str or Path is a file name; see ``SUPPORTED_EXTENSIONS``.
+        The heights. A str or Path is a file name; see ``SUPPORTED_EXTENSIONS`` (a file with another
+        extension is tried with GDAL).
     scalars : str, optional
         Name of the point array holding the heights (pyvista grids and VTK files). Default: the active
         point scalars; for a StructuredGrid with varying z the z coordinates are the heights.
     spacing, origin : (2,) floats, optional
-        Only for numpy arrays (defaults ``(1, 1)`` and ``(0, 0)``) and TIFF files without
-        georeferencing. A scalar spacing applies to both axes.
+        Only for numpy arrays (defaults ``(1, 1)`` and ``(0, 0)``) and rasters (TIFF, ...) without
+        georeference. A scalar spacing applies to both axes.
     nodata : float, optional
-        Value marking missing samples, in addition to NaN/inf. Overrides a GeoTIFF ``GDAL_NODATA`` tag.
+        Value marking missing samples, in addition to NaN/inf. Replaces a raster band's nodata value.
     fill : {None, "nearest", "linear"}
         None (default): missing samples raise ValueError. Otherwise fill them (see module notes).
     resample : {False, True, "linear", "cubic"}
         What to do with non-uniform RectilinearGrid/StructuredGrid coordinates: False raises
         ValueError; True/"linear"/"cubic" resample to a uniform grid (see module notes).
+    band : int
+        1-based band of a raster file read through GDAL (:mod:`.raster`).
+    crs : str, optional
+        A grid in a geographic CRS (degrees) is reprojected to a local metric CRS: by default the UTM
+        zone of its centre (reported in ``source``), or this projected CRS (``"EPSG:32632"``). See
+        :mod:`.georef`.
+    keep_geographic : bool
+        Keep a geographic grid on its degree lattice instead, x and y scaled by the length of a degree
+        at its centre latitude (stated in ``source``; true there only).
+    reproject : {"bilinear", "cubic", "nearest"}
+        How the heights are interpolated when a geographic grid is reprojected.
 
     Returns
     -------
@@ -204,9 +218,8 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
         Unsupported source type or non-numeric data.
     ValueError
         Bad shape, spacing or origin; missing samples without ``fill``; non-uniform grid without
-        ``resample``; rotated georeferencing; unknown extension.
-    ImportError
-        A GeoTIFF was given and ``tifffile`` is not installed.
+        ``resample``; rotated georeferencing; a file GDAL cannot open or read (truncated, corrupt);
+        a band out of range.
 
     Examples
     --------
@@ -232,14 +245,37 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
     if origin is not None:
         origin = check_geometry(origin, "origin", axes=2)
 
-    samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, nodata=nodata)
-    return _finish(samples, fill=fill, resample=resample)
+    samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, nodata=nodata, band=band)
+    return _georeference(_finish(samples, fill=fill, resample=resample), crs, keep_geographic, reproject)
 
 
-def _dispatch(source, *, scalars, spacing, origin, nodata) -> HeightSamples:
+def _georeference(grid: HeightGrid, crs, keep_geographic, reproject) -> HeightGrid:
+    """A grid in a geographic CRS to metres (:mod:`.georef`); other grids as they are."""
+    from .georef import is_geographic, scale_geographic, to_metric
+
+    geographic = is_geographic(grid.crs)
+    asked = "keep_geographic=True" if keep_geographic else (f"crs={crs!r}" if crs is not None else None)
+    if not geographic:
+        if asked is not None:
+            raise ValueError(f"{grid.source}: {asked} applies to a grid in a geographic CRS (degrees); this one is "
+                             f"in {grid.crs or 'no named CRS'}. Drop the argument (reproject it with gdalwarp first "
+                             "if you need another projected CRS).")
+        return grid
+    if keep_geographic and crs is not None:
+        raise ValueError(f"{grid.source}: pass either crs= (reproject to that CRS) or keep_geographic=True, not both.")
+    if keep_geographic:
+        m = scale_geographic(grid.heights, grid.spacing, grid.origin, grid.crs)
+    else:
+        m = to_metric(grid.heights, grid.spacing, grid.origin, grid.crs, target=crs, resampling=reproject,
+                      source=grid.source)
+    return HeightGrid(heights=m.heights, spacing=m.spacing, origin=m.origin, source=f"{grid.source}, {m.note}",
+                      crs=m.crs, units=grid.units)
+
+
+def _dispatch(source, *, scalars, spacing, origin, nodata, band) -> HeightSamples:
     kind = source_kind(source)
     if kind == "path":
-        return _read_file(Path(source), scalars=scalars, spacing=spacing, origin=origin, nodata=nodata)
+        return _read_file(Path(source), scalars=scalars, spacing=spacing, origin=origin, nodata=nodata, band=band)
     if kind == "vtk":
         import pyvista as pv
 
@@ -256,21 +292,28 @@ def _dispatch(source, *, scalars, spacing, origin, nodata) -> HeightSamples:
     )
 
 
-def _read_file(path: Path, *, scalars, spacing, origin, nodata) -> HeightSamples:
+def _read_file(path: Path, *, scalars, spacing, origin, nodata, band) -> HeightSamples:
     ext = path.suffix.lower()
-    if ext not in SUPPORTED_EXTENSIONS:
-        raise unsupported_extension(path, SUPPORTED_EXTENSIONS)
     require_regular_file(path, "height")
-    if ext in _TIFF_EXTENSIONS:
-        if scalars is not None:
-            raise ValueError(f"{path}: scalars= names a VTK point array; a TIFF has one band of heights.")
-        return read_geotiff(path, spacing, origin, nodata)
-    refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
-    if ext == ".dem":
-        if scalars is not None:
-            raise ValueError(f"{path}: scalars= names a VTK point array; a DEM has one elevation field.")
-        return read_dem(path, nodata)
-    return read_vtk_file(path, SUPPORTED_EXTENSIONS[ext], scalars, nodata)
+    if ext in VTK_FILES or ext == ".dem":
+        refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
+        if band != 1:
+            raise ValueError(f"{path}: band={band!r} picks a band of a raster read through GDAL; "
+                             f"a {SUPPORTED_EXTENSIONS[ext]} file has one field of heights.")
+        if ext == ".dem":
+            if scalars is not None:
+                raise ValueError(f"{path}: scalars= names a VTK point array; a DEM has one elevation field.")
+            return read_dem(path, nodata)
+        return read_vtk_file(path, SUPPORTED_EXTENSIONS[ext], scalars, nodata)
+    if scalars is not None:
+        raise ValueError(f"{path}: scalars= names a VTK point array; a raster has bands (pass band=).")
+    try:
+        return read_raster(path, spacing, origin, nodata, band=band)
+    except RasterOpenError as exc:
+        if ext in SUPPORTED_EXTENSIONS:
+            raise
+        raise unsupported_extension(path, SUPPORTED_EXTENSIONS,
+                                    f" GDAL could not open it either ({exc.gdal_message}).") from None
 
 
 # --------------------------------------------------------------------------------------------------

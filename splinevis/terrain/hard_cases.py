@@ -4,7 +4,7 @@ Each is a :class:`~splinevis.gl.contract.HardCase` that the tests and the self-t
 pixel (:func:`splinevis.analysis.agreement.depth_agreement`): grazing rays, rays along grid lines and through
 vertices, the underside, a camera inside the bounding box, UTM-sized coordinates, extreme zoom, flat and almost
 flat data, a grid wider than a texture row, and high-relief terrain (crater walls, a cliff of 150 cells)
-in every scheme at overview, oblique and close-up views. Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
+in every scheme at overview, oblique and close-up views, and parallel rays straight down (top views). Franke's function on 24 x 24 samples, the C2-cubic scheme, unless said otherwise.
 """
 
 from __future__ import annotations
@@ -128,7 +128,7 @@ def hard_cases() -> list:
     --------
     >>> cases = hard_cases()
     >>> len(cases), cases[0].name, cases[0].window_size, cases[5].clipping_range
-    (42, 'oblique', (400, 300), (0.001, 5.0))
+    (44, 'oblique', (400, 300), (0.001, 5.0))
     """
     size = (400, 300)
     grazing_z = 1.25
@@ -149,6 +149,11 @@ def hard_cases() -> list:
         HardCase("almost-flat", functools.partial(_flat, True), flat_view, size, min_hits=0.05),
         HardCase("wider-than-a-texture-row", _wide, [(2290.0, -25.0, 70.0), (2330.0, 16.0, 15.0), (0, 0, 1)], size,
                  min_hits=0.05),
+        # parallel rays straight down: no ray crosses a cell edge, every ray is (near) vertical
+        HardCase("parallel-top-view", _franke, [(0.5, 0.5, 3.0), (0.5, 0.5, 0.0), (0, 1, 0)], size, min_hits=0.5,
+                 parallel_scale=0.55),
+        HardCase("parallel-top-view-crater", functools.partial(_relief, "crater", "C2"),
+                 [(64.0, 64.0, 400.0), (64.0, 64.0, 0.0), (0, 1, 0)], size, min_hits=0.5, parallel_scale=70.0),
         HardCase("fractal-2048-steep", _steep_fractal, [(-600.0, -900.0, 4000.0), (1024.0, 1024.0, 900.0), (0, 0, 1)],
                  size, min_hits=0.05),
     ] + [HardCase(f"{kind}-{scheme}-{view}", functools.partial(_relief, kind, scheme), camera, size, min_hits=0.05)
