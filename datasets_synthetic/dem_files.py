@@ -2,8 +2,8 @@
 
 * :func:`write_usgs_ascii_dem` - a minimal USGS ASCII DEM (type A header + one type B record per
   column), readable by VTK's ``vtkDEMReader`` and :func:`splinevis.io.read_heights`.
-* :func:`write_geotiff` - a single-band GeoTIFF with ModelPixelScale/ModelTiepoint, GeoKeyDirectory
-  and GDAL_NODATA tags (needs the optional package ``tifffile``).
+* :func:`write_geotiff` - a single-band GeoTIFF (or COG) with CRS, nodata and PixelIsArea or
+  PixelIsPoint, through rasterio.
 * :func:`fractal_terrain` - spectral-synthesis fractal heights.
 
 All writers take heights in splinevis' orientation: ``heights[j, i]`` at ``(x0 + i*dx, y0 + j*dy)``,
@@ -151,8 +151,8 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
 
 # ---- GeoTIFF -----------------------------------------------------------------------------------------
 def write_geotiff(path, heights, spacing, origin, *, nodata=None, epsg: int | None = None,
-                  pixel_is_area: bool = True, dtype=np.float64) -> Path:
-    """Write a single-band, north-up GeoTIFF.
+                  pixel_is_area: bool = True, dtype=np.float64, driver: str = "GTiff") -> Path:
+    """Write a single-band, north-up GeoTIFF through rasterio (GDAL).
 
     Parameters
     ----------
@@ -163,43 +163,46 @@ def write_geotiff(path, heights, spacing, origin, *, nodata=None, epsg: int | No
     spacing, origin : (2,) floats
         Sample spacing and the south-west sample position.
     nodata : float, optional
-        Written to the GDAL_NODATA tag (42113).
+        The band's nodata value (GDAL_NODATA tag).
     epsg : int, optional
-        Projected CRS code (ProjectedCSTypeGeoKey 3072, with GTModelType "projected").
+        CRS as an EPSG code (projected or geographic).
     pixel_is_area : bool
-        GTRasterTypeGeoKey: True writes PixelIsArea, so the tiepoint is the outer corner of the
-        north-west pixel, half a pixel beyond the sample; False writes PixelIsPoint (tiepoint = sample).
+        ``AREA_OR_POINT``: True writes PixelIsArea (the tiepoint is the outer corner of the north-west
+        pixel, half a pixel beyond the sample); False writes PixelIsPoint (tiepoint = the sample).
+        Either way each sample is at its own position when read back through GDAL.
     dtype : numpy dtype
         Sample type stored (default float64: exact round trips).
+    driver : str
+        ``"GTiff"`` or ``"COG"`` (cloud-optimized GeoTIFF).
+
+    Examples
+    --------
+    >>> import tempfile, rasterio
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = write_geotiff(Path(folder) / "h.tif", [[1.0, 2.0], [3.0, 4.0]], (10.0, 10.0), (5e5, 5e6),
+    ...                          epsg=32633, pixel_is_area=False)
+    ...     with rasterio.open(path) as ds:
+    ...         stored, corner, point = ds.read(1).tolist(), (ds.transform.c, ds.transform.f), ds.tags()["AREA_OR_POINT"]
+    >>> stored, corner, point  # north row first; GDAL's corner is half a pixel beyond the NW sample
+    ([[3.0, 4.0], [1.0, 2.0]], (499995.0, 5000015.0), 'Point')
     """
-    try:
-        import tifffile
-    except ImportError:
-        raise ImportError("write_geotiff needs the package 'tifffile' (pip install tifffile).") from None
+    import rasterio
+    from affine import Affine
+
     h, (dx, dy), (x0, y0) = _check_grid(heights, spacing, origin)
     ny, nx = h.shape
     if nodata is not None:
         h = np.where(np.isnan(h), nodata, h)
     data = np.ascontiguousarray(h[::-1, :]).astype(dtype)  # north row first
     y_top = y0 + (ny - 1) * dy
-    half = 0.5 if pixel_is_area else 0.0
-    tie = (0.0, 0.0, 0.0, x0 - half * dx, y_top + half * dy, 0.0)
-    keys = [(1024, 1 if epsg else 0), (1025, 1 if pixel_is_area else 2)]
-    if epsg:
-        keys += [(3072, int(epsg)), (3076, 9001)]
-    keys = [k for k in keys if k[1] != 0]
-    directory = [1, 1, 0, len(keys)]
-    for key_id, value in keys:
-        directory += [key_id, 0, 1, value]
-    extratags = [
-        (33550, "d", 3, (dx, dy, 0.0), False),
-        (33922, "d", 6, tie, False),
-        (34735, "H", len(directory), tuple(directory), False),
-    ]
-    if nodata is not None:
-        extratags.append((42113, "s", 0, repr(float(nodata)), False))
+    # GDAL's geotransform always names the outer corner of the north-west pixel; for PixelIsPoint GDAL
+    # itself writes the tiepoint half a pixel inwards, on the sample.
+    transform = Affine(dx, 0.0, x0 - 0.5 * dx, 0.0, -dy, y_top + 0.5 * dy)
     path = Path(path)
-    tifffile.imwrite(path, data, extratags=extratags, metadata=None)
+    with rasterio.open(path, "w", driver=driver, width=nx, height=ny, count=1, dtype=data.dtype,
+                       crs=f"EPSG:{int(epsg)}" if epsg else None, transform=transform, nodata=nodata) as ds:
+        ds.update_tags(AREA_OR_POINT="Area" if pixel_is_area else "Point")
+        ds.write(data, 1)
     return path
 
 

@@ -4,10 +4,8 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from datasets_synthetic.dem_files import DEM_VOID, fractal_terrain, write_geotiff, write_usgs_ascii_dem
+from datasets_synthetic.dem_files import DEM_VOID, fractal_terrain, write_usgs_ascii_dem
 from splinevis.io import HeightGrid, read_heights
-
-tifffile = pytest.importorskip("tifffile")
 
 UTM = (5e5, 5.1e6)
 
@@ -301,75 +299,31 @@ def test_usgs_dem_truncated_mid_profile_is_a_clear_error(tmp_path):
         read_heights(whole)
 
 
+def test_usgs_dem_where_gdal_fails_our_parser_gives_the_known_answer(tmp_path):
+    # GDAL 3.10's USGSDEM driver (measured, see splinevis/io/dem.py): it snaps the raster to multiples
+    # of the spacing, so samples starting at a northing that is not a multiple of 30 m are read 10 m
+    # off; and it cannot read six-digit elevation fields that touch (1000 m at z resolution 0.01 is
+    # 100000). Our parser must put every sample at its true (x, y) with its true height in both cases.
+    nx, ny, d = 7, 5, 30.0
+    x0, y0 = 500010.0, 5100020.0  # x a multiple of 30, y not
+    for base, zres in ((100.0, 0.1), (1000.0, 0.01)):  # 4-5 digit fields, then touching 6-digit ones
+        h = base + 3.0 * np.arange(nx)[None, :] + 7.0 * np.arange(ny)[:, None]
+        path = write_usgs_ascii_dem(tmp_path / f"g{base:.0f}.dem", h, d, (x0, y0), z_resolution=zres)
+        if base == 1000.0:
+            assert "100000100700" in path.read_text()  # the fields touch (first profile, rows 0 and 1)
+        g = read_heights(path)
+        np.testing.assert_array_equal(g.x, x0 + d * np.arange(nx))
+        np.testing.assert_array_equal(g.y, y0 + d * np.arange(ny))
+        np.testing.assert_allclose(g.heights, h, rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(g.heights, np.rint(h / zres) * zres)  # float64, stored integers * zres
+
+
 def test_dem_writer_refuses_float32_inexact_geometry(tmp_path):
     with pytest.raises(ValueError, match=r"vtkDEMReader would count .* samples in x"):
         write_usgs_ascii_dem(tmp_path / "x.dem", np.zeros((3, 200)), (0.1, 1.0), (5e5 + 0.05, 5.1e6))
 
 
-# ---- GeoTIFF ---------------------------------------------------------------------------------------------
-def test_geotiff_north_up_ramp_flipped_and_exact(tmp_path):
-    ny, nx = 5, 3
-    h = np.repeat(np.arange(ny, dtype=np.float64)[:, None] * 10.0, nx, axis=1)  # increases to the north
-    path = write_geotiff(tmp_path / "r.tif", h, (2.0, 3.0), UTM, epsg=32633)
-    stored = tifffile.imread(path)
-    assert stored[0, 0] == 40.0  # the file stores the northern row first
-    g = read_heights(path)
-    assert np.all(np.diff(g.heights[:, 0]) > 0)  # increasing with j = northwards
-    assert np.array_equal(g.heights, h) and g.spacing == (2.0, 3.0) and g.origin == UTM
-    assert g.crs == "EPSG:32633"
-
-
-def _tiff(path, data, tie, scale=None, raster_type=1, transform=None):
-    tags = [(34735, "H", 8, (1, 1, 0, 1, 1025, 0, 1, raster_type), False)]
-    if transform is not None:
-        tags.append((34264, "d", 16, tuple(transform), False))
-    else:
-        tags += [(33550, "d", 3, scale, False), (33922, "d", 6, tie, False)]
-    tifffile.imwrite(path, np.asarray(data, dtype=np.float32), extratags=tags, metadata=None)
-    return path
-
-
-def test_geotiff_pixel_is_area_shifts_origin_by_half_a_pixel(tmp_path):
-    data = np.arange(6, dtype=np.float32).reshape(3, 2)  # row 0 north
-    tie, scale = (0, 0, 0, 1000.0, 2000.0, 0), (10.0, 20.0, 0.0)
-    area = read_heights(_tiff(tmp_path / "a.tif", data, tie, scale, raster_type=1))
-    # centre of the south-west pixel: x = 1000 + 0.5*10, y = 2000 - 2.5*20
-    assert area.origin == (1005.0, 1950.0) and area.spacing == (10.0, 20.0)
-    point = read_heights(_tiff(tmp_path / "p.tif", data, tie, scale, raster_type=2))
-    assert point.origin == (1000.0, 1960.0)
-    np.testing.assert_array_equal(area.heights, data[::-1])
-    # the writer puts the tiepoint on the pixel corner for PixelIsArea
-    path = write_geotiff(tmp_path / "w.tif", np.zeros((3, 2)), (10.0, 20.0), (1005.0, 1950.0))
-    with tifffile.TiffFile(path) as tif:
-        assert tif.pages[0].tags[33922].value == (0.0, 0.0, 0.0, 1000.0, 2000.0, 0.0)
-    assert read_heights(path).origin == (1005.0, 1950.0)
-
-
-def test_geotiff_nodata_message_and_fill(tmp_path):
-    h = plane(4, 3, 2.0, 3.0)
-    h[0, 1] = np.nan  # south row -> stored row 2
-    path = write_geotiff(tmp_path / "n.tif", h, (2.0, 3.0), UTM, nodata=-9999.0, dtype=np.float32)
-    with pytest.raises(ValueError, match=r"n\.tif: 1 of 12 samples are missing.*\(row, col\) = \(2, 1\) \[\(row, col\) "
-                                         r"as stored, row 0 = north\], \(x, y\) = \(500002.0, 5100000.0\), value "
-                                         r"-9999.0. Pass fill='nearest' or fill='linear'"):
-        read_heights(path)
-    g = read_heights(path, fill="linear")
-    np.testing.assert_allclose(g.heights, plane(4, 3, 2.0, 3.0), atol=1e-5)
-
-
-def test_geotiff_rotation_plain_tiff_and_overrides(tmp_path):
-    m = [1.0, 0.2, 0, 100.0, 0.1, -1.0, 0, 200.0, 0, 0, 0, 0, 0, 0, 0, 1]
-    with pytest.raises(ValueError, match=r"rot\.tif: ModelTransformationTag has rotation/shear terms \(0.2, 0.1\)"):
-        read_heights(_tiff(tmp_path / "rot.tif", np.zeros((2, 2)), None, transform=m))
-    plain = tmp_path / "plain.tif"
-    tifffile.imwrite(plain, np.array([[2.0, 3.0], [0.0, 1.0]]))
-    with pytest.raises(ValueError, match=r"plain\.tif: no GeoTIFF georeferencing .* pass spacing= and origin="):
-        read_heights(plain)
-    g = read_heights(plain, spacing=(1, 1), origin=(0, 0))
-    np.testing.assert_array_equal(g.heights, [[0.0, 1.0], [2.0, 3.0]])
-    geo = write_geotiff(tmp_path / "geo.tif", np.zeros((2, 2)), (1.0, 1.0), (0.0, 0.0))
-    with pytest.raises(ValueError, match=r"geo\.tif \(georeferenced\) carries its own spacing and origin"):
-        read_heights(geo, origin=(5.0, 5.0))
+# GeoTIFF and the other rasters read through rasterio/GDAL: tests/test_io_raster.py
 
 
 # ---- synthetic terrain -------------------------------------------------------------------------------------

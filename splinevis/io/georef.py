@@ -114,7 +114,12 @@ def _ellipsoid(c) -> tuple:
 
 @dataclass(frozen=True)
 class Metric:
-    """A grid after :func:`to_metric` or :func:`scale_geographic`: heights rows south to north, NaN gaps."""
+    """A grid after :func:`to_metric` or :func:`scale_geographic`: heights rows south to north.
+
+    >>> m = Metric(np.zeros((2, 2)), (30.0, 30.0), (5e5, 5e6), "EPSG:32632", "reprojected ...")
+    >>> m.crs, m.spacing
+    ('EPSG:32632', (30.0, 30.0))
+    """
 
     heights: np.ndarray
     spacing: tuple
