@@ -1,0 +1,142 @@
+"""A NURBS model: patches that keep their identity, with optional trim loops in each patch's domain.
+
+Trim loops are closed chains of 2-D NURBS curves in the patch's ``(u, v)`` parameter domain (IGES entity
+144, a Rhino BrepFace's loops, an OpenCASCADE face's wires). A parameter is kept when it lies inside an
+odd number of the patch's loops (even-odd rule: the outer loop and nested holes/islands need no labels);
+a patch without loops keeps its whole domain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .basis import check_knots, ders_basis_funs, find_span
+from .surface import NurbsSurface
+
+__all__ = ["TrimCurve", "NurbsModel"]
+
+
+@dataclass(frozen=True, eq=False)
+class TrimCurve:
+    """A 2-D (rational) B-spline curve in a patch's parameter domain.
+
+    Examples
+    --------
+    >>> c = TrimCurve(1, [0, 0, 1, 1], [[0.1, 0.1], [0.9, 0.1]])
+    >>> c.evaluate([0.5])
+    array([[0.5, 0.1]])
+    """
+
+    degree: int
+    knots: np.ndarray
+    control_points: np.ndarray
+    weights: np.ndarray | None = None
+
+    def __post_init__(self):
+        P = np.array(self.control_points, dtype=np.float64)
+        if P.ndim != 2 or P.shape[1] != 2:
+            raise ValueError(f"trim curve control_points must have shape (n, 2), got {P.shape}.")
+        U = check_knots(self.knots, int(self.degree), P.shape[0], "trim curve knots")
+        W = None if self.weights is None else np.array(self.weights, dtype=np.float64)
+        if W is not None and (W.shape != (P.shape[0],) or not (np.isfinite(W) & (W > 0)).all()):
+            raise ValueError(f"trim curve weights must be {P.shape[0]} positive numbers, got {self.weights!r}.")
+        object.__setattr__(self, "degree", int(self.degree))
+        object.__setattr__(self, "knots", U)
+        object.__setattr__(self, "control_points", P)
+        object.__setattr__(self, "weights", W)
+
+    @property
+    def domain(self) -> tuple:
+        """``(t0, t1)``.
+
+        >>> TrimCurve(1, [0, 0, 2, 2], [[0, 0], [1, 1]]).domain
+        (0.0, 2.0)
+        """
+        n = self.control_points.shape[0]
+        return float(self.knots[self.degree]), float(self.knots[n])
+
+    def evaluate(self, t) -> np.ndarray:
+        """Points ``(len(t), 2)`` [PieglTiller1997, A4.1].
+
+        >>> from splinevis.nurbs.exact import circle_net
+        >>> xy, w = circle_net()
+        >>> from splinevis.nurbs.exact import CIRCLE_KNOTS
+        >>> c = TrimCurve(2, CIRCLE_KNOTS, 0.5 + 0.25 * xy, w)  # a circle of radius 1/4 about (1/2, 1/2)
+        >>> np.round(c.evaluate([0.125, 0.5]), 12).tolist()
+        [[0.676776695297, 0.676776695297], [0.25, 0.5]]
+        """
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        p, U = self.degree, self.knots
+        span = find_span(p, U, t)
+        N = ders_basis_funs(span, t, p, 0, U)[:, 0, :]
+        idx = span[:, None] - p + np.arange(p + 1)
+        w = np.ones(self.control_points.shape[0]) if self.weights is None else self.weights
+        Pw = self.control_points[idx] * w[idx][..., None]
+        return np.einsum("ma,mac->mc", N, Pw) / np.einsum("ma,ma->m", N, w[idx])[:, None]
+
+
+@dataclass(frozen=True, eq=False)
+class NurbsModel:
+    """Patches of a NURBS model.
+
+    Parameters
+    ----------
+    surfaces : sequence of NurbsSurface
+        Each keeps its ``name`` (the file's entity / object id).
+    trims : sequence (one per surface) of None or a list of loops (each a list of TrimCurve)
+    source : str
+        Where the model came from (a file name, "sphere", ...), and what a reader skipped.
+
+    Examples
+    --------
+    >>> from splinevis.nurbs.exact import sphere, torus
+    >>> m = NurbsModel([sphere(), torus()], source="two shapes")
+    >>> len(m), m.names, m.trims
+    (2, ('sphere', 'torus'), (None, None))
+    >>> m.bounds()[4:]  # z range of the control points
+    (-1.0, 1.0)
+    """
+
+    surfaces: tuple
+    trims: tuple = ()
+    source: str = ""
+    skipped: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        surfaces = tuple(self.surfaces)
+        if not surfaces:
+            raise ValueError(f"a NurbsModel needs at least one surface ({self.source or 'no source'}).")
+        for k, s in enumerate(surfaces):
+            if not isinstance(s, NurbsSurface):
+                raise TypeError(f"surfaces[{k}] must be a NurbsSurface, got {type(s).__name__}.")
+        trims = tuple(self.trims) if self.trims else (None,) * len(surfaces)
+        if len(trims) != len(surfaces):
+            raise ValueError(f"trims must have one entry (None or loops) per surface: {len(trims)} for {len(surfaces)}.")
+        object.__setattr__(self, "surfaces", surfaces)
+        object.__setattr__(self, "trims", tuple(None if t is None else tuple(tuple(loop) for loop in t) for t in trims))
+
+    def __len__(self) -> int:
+        return len(self.surfaces)
+
+    @property
+    def names(self) -> tuple:
+        """Each patch's name.
+
+        >>> from splinevis.nurbs.exact import saddle
+        >>> NurbsModel([saddle()]).names
+        ('saddle',)
+        """
+        return tuple(s.name for s in self.surfaces)
+
+    def bounds(self) -> tuple:
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of all control points (the convex-hull box).
+
+        >>> from splinevis.nurbs.exact import saddle
+        >>> NurbsModel([saddle(2.0)]).bounds()
+        (-2.0, 2.0, -2.0, 2.0, -8.0, 8.0)
+        """
+        P = np.concatenate([s.control_points.reshape(-1, 3) for s in self.surfaces])
+        lo, hi = P.min(axis=0), P.max(axis=0)
+        return tuple(float(v) for pair in zip(lo, hi) for v in pair)
