@@ -16,15 +16,17 @@ specular        Phong specular term on every light
 colormap        base colour from the surface scalar (height for terrains) through a matplotlib colormap
 texture         base colour from an RGB(A) image draped by the surface's (u, v)
 environment     reflection of a latitude-longitude environment image
-reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray
+reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray (zebra)
+highlight_lines   bands where the surface normal line meets one of a family of linear lights (view-independent)
 isophotes       stripes of constant ``dot(n, L)``
 transparency    ``opacity < 1``: alpha output, composited by VTK's translucent pass
 normals         output colour = encoded unit normal ``0.5 * (n + 1)`` (replaces shading)
-curvature       output colour = mean curvature through a diverging colormap (replaces shading)
+curvature       output colour = a curvature (mean, Gaussian, principal) through a diverging colormap
+draft           output colour = draft angle against a pull direction (green / yellow / red)
 depth           output colour = window depth in the red channel (replaces shading)
 ============== ===================================================================================
 
-``normals``, ``curvature`` and ``depth`` are output modes: at most one of them may be declared.
+``normals``, ``curvature``, ``draft`` and ``depth`` are output modes: at most one of them may be declared.
 """
 
 from __future__ import annotations
@@ -36,10 +38,12 @@ import numpy as np
 
 from ._validation import as_float64_array, check_choice
 
-__all__ = ["Style", "EFFECTS", "OUTPUT_MODES", "MAX_LIGHTS"]
+__all__ = ["Style", "EFFECTS", "OUTPUT_MODES", "MAX_LIGHTS", "CURVATURE_KINDS", "line_frame"]
 
 MAX_LIGHTS = 4
-OUTPUT_MODES = ("normals", "curvature", "depth")
+OUTPUT_MODES = ("normals", "curvature", "draft", "depth")
+#: What ``output="curvature"`` shows (``Style.curvature``), as the GLSL's sv_curvature_kind.
+CURVATURE_KINDS = {"mean": 0, "gaussian": 1, "k1": 2, "k2": 3, "max": 4}
 #: effect name -> (GLSL flag, include file). 'lights' and 'specular' share the lighting file.
 EFFECTS: dict[str, tuple[str, str]] = {
     "lights": ("SV_NUM_LIGHTS", "lib/effects/lights.glsl"),
@@ -48,10 +52,12 @@ EFFECTS: dict[str, tuple[str, str]] = {
     "texture": ("SV_TEXTURE", "lib/effects/texture.glsl"),
     "environment": ("SV_ENVIRONMENT", "lib/effects/environment.glsl"),
     "reflection_lines": ("SV_REFLECTION_LINES", "lib/effects/reflection_lines.glsl"),
+    "highlight_lines": ("SV_HIGHLIGHT_LINES", "lib/effects/highlight_lines.glsl"),
     "isophotes": ("SV_ISOPHOTES", "lib/effects/isophotes.glsl"),
     "transparency": ("SV_TRANSPARENCY", "lib/effects/transparency.glsl"),
     "normals": ("SV_OUT_NORMALS", "lib/effects/normals.glsl"),
     "curvature": ("SV_OUT_CURVATURE", "lib/effects/curvature.glsl"),
+    "draft": ("SV_OUT_DRAFT", "lib/effects/draft.glsl"),
     "depth": ("SV_OUT_DEPTH", "lib/effects/depth.glsl"),
 }
 
@@ -72,6 +78,31 @@ def _rgb(value, name):
     if arr.min() < 0 or arr.max() > 1:
         raise ValueError(f"{name} must have RGB components in [0, 1], got {tuple(arr)}.")
     return tuple(float(c) for c in arr)
+
+
+def _unit(value, name):
+    v = as_float64_array(value, name, ndim=1, shape_tail=(3,))
+    size = float(np.linalg.norm(v))
+    if size == 0:
+        raise ValueError(f"{name} must be a non-zero direction, got {tuple(v)}.")
+    return tuple(float(c) for c in v / size)
+
+
+def line_frame(axis) -> tuple:
+    """``(b, c)``: unit vectors with ``(axis, b, c)`` right-handed orthonormal; ``c`` leans towards +z (towards
+    +y for an axis along z). For the x axis ``b = y``, ``c = z``.
+
+    >>> line_frame((1, 0, 0))
+    ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    >>> line_frame((0, 0, 1))
+    ((0.0, -1.0, 0.0), (1.0, 0.0, 0.0))
+    """
+    a = np.asarray(_unit(axis, "axis"))
+    up = np.array([0.0, 0.0, 1.0]) if abs(a[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    c = up - np.dot(up, a) * a
+    c /= np.linalg.norm(c)
+    b = np.cross(c, a)
+    return tuple(float(v) + 0.0 for v in b), tuple(float(v) + 0.0 for v in c)
 
 
 @dataclass(frozen=True)
@@ -99,15 +130,32 @@ class Style:
     environment : (H, W, 3) uint8 ndarray, optional
         Latitude-longitude environment image, reflected by the surface.
     reflection_lines : int, optional
-        Number of parallel light lines (reflection-line stripes) across the field of view.
+        Number of parallel light lines (reflection-line stripes) over a half turn about their axis.
+    reflection_axis : (3,) float, default (1, 0, 0)
+        Direction of the light lines (world frame).
+    highlight_lines : float, optional
+        Spacing (world units) of linear lights for highlight lines [BeierChen1994].
+    highlight_axis : (3,) float, default (1, 0, 0)
+        Direction of the linear lights.
+    highlight_plane : (3,) float, default (0, 0, 1)
+        Normal of the plane that holds the lights (``highlight_axis`` must lie in it).
+    highlight_height : float, optional
+        The plane's offset along ``highlight_plane`` (world); default: above the model by its size.
     isophotes : int, optional
         Number of isophote bands of ``dot(n, L)`` for the first light direction.
-    output : {"normals", "curvature", "depth"}, optional
+    output : {"normals", "curvature", "draft", "depth"}, optional
         Replace shading by an analysis output.
+    curvature : {"mean", "gaussian", "k1", "k2", "max"}, default "mean"
+        What ``output="curvature"`` shows: mean, Gaussian, maximum / minimum principal curvature, or the
+        principal curvature of larger magnitude (a uniform).
+    pull_direction : (3,) float, default (0, 0, 1)
+        Mould pull direction for ``output="draft"``.
+    draft_angle : float, default 1.0
+        Smallest acceptable draft in degrees (``output="draft"``).
     ambient, diffuse, specular_power : float
         Lighting parameters (uniforms; changing them does not recompile).
     curvature_scale : float, default 1.0
-        Mean curvature shown at full colour by ``output="curvature"`` (a uniform).
+        Curvature shown at full colour by ``output="curvature"`` (a uniform).
     opacity : float in (0, 1], default 1.0
         Below 1 the surface is drawn translucent over opaque meshes (effect ``transparency``: the alpha
         output is compiled in and VTK's translucent pass composites it). Every sheet a ray crosses is
@@ -132,8 +180,16 @@ class Style:
     texture_extent: tuple | None = None
     environment: Any = field(default=None, compare=False, hash=False)
     reflection_lines: int | None = None
+    reflection_axis: tuple = (1.0, 0.0, 0.0)
+    highlight_lines: float | None = None
+    highlight_axis: tuple = (1.0, 0.0, 0.0)
+    highlight_plane: tuple = (0.0, 0.0, 1.0)
+    highlight_height: float | None = None
     isophotes: int | None = None
     output: str | None = None
+    curvature: str = "mean"
+    pull_direction: tuple = (0.0, 0.0, 1.0)
+    draft_angle: float = 1.0
     ambient: float = 0.15
     diffuse: float = 0.85
     specular_power: float = 40.0
@@ -177,6 +233,16 @@ class Style:
             raise ValueError("Style.isophotes are bands of dot(n, L) for the first light: set lights >= 1.")
         if self.output is not None:
             check_choice(self.output, "Style.output", OUTPUT_MODES)
+        check_choice(self.curvature, "Style.curvature", tuple(CURVATURE_KINDS))
+        for name in ("reflection_axis", "highlight_axis", "highlight_plane", "pull_direction"):
+            object.__setattr__(self, name, _unit(getattr(self, name), f"Style.{name}"))
+        if abs(float(np.dot(self.highlight_axis, self.highlight_plane))) > 1e-9:
+            raise ValueError(f"Style.highlight_axis {self.highlight_axis} must lie in the plane of lights (be "
+                             f"perpendicular to Style.highlight_plane {self.highlight_plane}).")
+        if self.highlight_lines is not None and not (np.isfinite(self.highlight_lines) and self.highlight_lines > 0):
+            raise ValueError(f"Style.highlight_lines is the spacing of the lights, a number > 0; got {self.highlight_lines!r}.")
+        if not (np.isfinite(self.draft_angle) and 0 <= self.draft_angle < 90):
+            raise ValueError(f"Style.draft_angle must be degrees in [0, 90), got {self.draft_angle!r}.")
         if isinstance(self.opacity, bool) or not isinstance(self.opacity, (int, float, np.floating)) or not 0 < self.opacity <= 1:
             raise ValueError(f"Style.opacity must be a number in (0, 1], got {self.opacity!r}.")
 
@@ -203,7 +269,7 @@ class Style:
             on.add("specular")
         if self.colormap is not None:
             on.add("colormap")
-        for name in ("texture", "environment", "reflection_lines", "isophotes"):
+        for name in ("texture", "environment", "reflection_lines", "highlight_lines", "isophotes"):
             if getattr(self, name) is not None:
                 on.add(name)
         if self.opacity < 1:
@@ -260,19 +326,28 @@ class Style:
         Examples
         --------
         >>> Style(lights=1, color=(1.0, 0.5, 0.0), reflection_lines=8).uniforms()
-        {'sv_color': (1.0, 0.5, 0.0), 'sv_ambient': 0.15, 'sv_diffuse': 0.85, 'sv_stripes': 8.0}
+        {'sv_color': (1.0, 0.5, 0.0), 'sv_ambient': 0.15, 'sv_diffuse': 0.85, 'sv_stripes': 8.0, 'sv_line_b': (0.0, 1.0, 0.0), 'sv_line_c': (0.0, 0.0, 1.0)}
         """
         u = {"sv_color": self.color, "sv_ambient": float(self.ambient), "sv_diffuse": float(self.diffuse)}
         if self.specular:
             u["sv_specular_power"] = float(self.specular_power)
         if self.reflection_lines is not None:
             u["sv_stripes"] = float(self.reflection_lines)
+            u["sv_line_b"], u["sv_line_c"] = line_frame(self.reflection_axis)
+        if self.highlight_lines is not None:
+            u["sv_highlight_plane"] = self.highlight_plane
+            u["sv_highlight_across"] = tuple(float(v) for v in np.cross(self.highlight_plane, self.highlight_axis))
+            u["sv_highlight_spacing"] = float(self.highlight_lines)
         if self.isophotes is not None:
             u["sv_isophote_bands"] = float(self.isophotes)
         if self.colormap is not None and self.scalar_range is not None:
             u["sv_scalar_range"] = tuple(float(v) for v in self.scalar_range)
         if self.output == "curvature":
             u["sv_curvature_scale"] = float(self.curvature_scale)
+            u["sv_curvature_kind"] = CURVATURE_KINDS[self.curvature]
+        if self.output == "draft":
+            u["sv_pull_dir"] = self.pull_direction
+            u["sv_draft_min"] = float(self.draft_angle)
         if self.opacity < 1:
             u["sv_opacity"] = float(self.opacity)
         return u

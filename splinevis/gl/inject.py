@@ -482,6 +482,22 @@ class SplineActor:
         su, sv = (mx1 - mx0) / (ex1 - ex0), (my1 - my0) / (ey1 - ey0)
         return (su, sv, (mx0 - ex0) / (ex1 - ex0), (my0 - ey0) / (ey1 - ey0))
 
+    def _highlight_frame(self) -> dict:
+        """The plane of highlight lights in the model frame: world ``m . x = h`` is model
+        ``(R^T m) . p = h - m . position``; the default ``h`` lies one bounding-box diagonal above the model."""
+        R = np.eye(3) if self.rotation is None else self.rotation
+        m = np.asarray(self.style.highlight_plane)
+        across = np.cross(m, np.asarray(self.style.highlight_axis))
+        x0, x1, y0, y1, z0, z1 = self.poly.GetBounds()
+        corners = np.array(np.meshgrid([x0, x1], [y0, y1], [z0, z1])).reshape(3, -1).T  # model frame
+        m_model = R.T @ m
+        if self.style.highlight_height is None:
+            h_model = float((corners @ m_model).max() + np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
+        else:
+            h_model = float(self.style.highlight_height - m @ self.position)
+        return {"sv_highlight_plane": m_model, "sv_highlight_across": R.T @ across, "sv_highlight_height": h_model,
+                "sv_highlight_shift": float(across @ self.position)}
+
     def frame_uniforms(self) -> dict:
         """All uniforms for the next frame: camera, lights, spec, style and extras.
 
@@ -511,6 +527,8 @@ class SplineActor:
         u.update(self.style.uniforms())
         if self.style.texture is not None:
             u["sv_texture_map"] = self._texture_map()
+        if self.style.highlight_lines is not None:
+            u.update(self._highlight_frame())
         if self.rotation is not None and self.spec.world_frame is not None:
             u["sv_world_from_model[]"] = self.rotation
         u.update(self.extra_uniforms)

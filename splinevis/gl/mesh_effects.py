@@ -41,10 +41,11 @@ _FS_LIGHT = """//VTK::Light::Impl
 
 
 def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", ambient: float = 0.15,
-                                   diffuse: float = 0.85):
+                                   diffuse: float = 0.85, axis=(1.0, 0.0, 0.0)):
     """Add ``mesh`` (point normals are used, e.g. from marching cubes; computed if absent) to ``plotter``,
     Phong-shaded with VTK's lights, with ``stripes`` reflection lines computed as for the splines
-    (``Style(reflection_lines=stripes)``). The mesh is in world coordinates (no actor transform).
+    (``Style(reflection_lines=stripes, reflection_axis=axis)``). The mesh is in world coordinates (no actor
+    transform).
 
     Returns the vtkActor. (A vtkOpenGLPolyDataMapper of our own: pyvista's DataSetMapper renders through
     an internal mapper whose shader events it does not forward.)
@@ -88,6 +89,9 @@ def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", 
     sp.AddFragmentShaderReplacement("//VTK::Normal::Dec", True, _FS_DEC + code, False)
     sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
     renderer = plotter.renderer
+    from ..effects import line_frame
+
+    line_b, line_c = line_frame(axis)
 
     def update(caller, event, program=None):
         if program is None:
@@ -95,6 +99,8 @@ def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", 
         eye = np.array(renderer.GetActiveCamera().GetPosition(), dtype=np.float64)
         _set_uniform(program, "sv_eye_mc", eye)
         _set_uniform(program, "sv_stripes", float(stripes))
+        _set_uniform(program, "sv_line_b", np.asarray(line_b))
+        _set_uniform(program, "sv_line_c", np.asarray(line_c))
 
     update.CallDataType = VTK_OBJECT
     mapper.AddObserver(vtkCommand.UpdateShaderEvent, update)
@@ -135,7 +141,8 @@ def add_mesh_with_effects(plotter, mesh, style, *, name=None):
                          f"{', '.join(sorted(MESH_EFFECTS))}. Remove them from the Style.")
     if style.reflection_lines:
         actor = add_mesh_with_reflection_lines(plotter, mesh, int(style.reflection_lines), color=style.color,
-                                               ambient=style.ambient, diffuse=style.diffuse)
+                                               ambient=style.ambient, diffuse=style.diffuse,
+                                               axis=style.reflection_axis)
         actor.GetProperty().SetOpacity(float(style.opacity))
         return actor
     return plotter.add_mesh(mesh, color=style.color, smooth_shading=True, ambient=style.ambient,

@@ -20,6 +20,8 @@ vec4 sv_shade(SvHit h, vec3 rd) {
     return vec4(sv_normal_color(sv_to_world(n)), 1.0);
 #elif defined(SV_OUT_CURVATURE)
     return vec4(sv_curvature_color(h.curvature), 1.0);
+#elif defined(SV_OUT_DRAFT)
+    return vec4(sv_draft_color(sv_to_world(h.normal)), 1.0);
 #elif defined(SV_OUT_DEPTH)
     return vec4(h.depth, 0.0, 0.0, 1.0);
 #else
@@ -39,6 +41,9 @@ vec4 sv_shade(SvHit h, vec3 rd) {
 #endif
 #ifdef SV_REFLECTION_LINES
     col *= sv_reflection_lines(sv_to_world(reflect(rd, n)));
+#endif
+#ifdef SV_HIGHLIGHT_LINES
+    col *= sv_highlight_lines(h.pos, n);
 #endif
 #ifdef SV_ISOPHOTES
     col *= sv_isophotes(n);
