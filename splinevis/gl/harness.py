@@ -47,7 +47,8 @@ def _harness_text(n_in_tex: int, n_out_att: int, functions: str, body: str) -> s
     return "\n".join(lines) + "\n"
 
 
-def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, root: Path | None = None) -> np.ndarray:
+def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, root: Path | None = None,
+             tables=None) -> np.ndarray:
     """Evaluate GLSL code on every row of ``inputs`` in one draw call.
 
     Parameters
@@ -67,6 +68,9 @@ def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, r
         Compile-time flags for :func:`assemble`.
     root : Path, optional
         Another GLSL root (tests use a temporary one).
+    tables : mapping of str to (H, W, 4) float32 array, optional
+        Table textures the functions read (``uniform sampler2D <name>``, declared by the functions), e.g.
+        a program's coefficient table from :func:`splinevis.gl.proxies.pack_rgba32f`.
 
     Returns
     -------
@@ -115,9 +119,11 @@ def run_glsl(functions: str, body: str, inputs, outputs: int, *, defines=None, r
     padded = np.zeros((width * height, 4 * n_tex), dtype=np.float32)
     padded[:m, :k] = x
     textures = {f"in{i}": padded[:, 4 * i:4 * i + 4].reshape(height, width, 4) for i in range(n_tex)}
+    tables = dict(tables or {})
+    textures.update({f"table_{name}": np.ascontiguousarray(t, dtype=np.float32) for name, t in tables.items()})
     step = Pass(
         _harness_text(n_tex, n_att, functions, body),
-        inputs={f"sv_tex_in{i}": f"in{i}" for i in range(n_tex)},
+        inputs={**{f"sv_tex_in{i}": f"in{i}" for i in range(n_tex)}, **{name: f"table_{name}" for name in tables}},
         outputs=tuple(f"out{j}" for j in range(n_att)),
         shape=(height, width),
         defines=defines,

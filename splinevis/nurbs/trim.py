@@ -1,0 +1,201 @@
+"""Trim loops as v-monotone rational Bezier pieces, and the even-odd inside test on them (float64 twin of
+``glsl/lib/nurbs/trim.glsl``).
+
+Each :class:`~splinevis.nurbs.model.TrimCurve` (degree 1..3) is cut into its Bezier segments by knot
+insertion [PieglTiller1997, A5.1] and each segment at the parameters where ``v(t)`` turns (roots of the
+numerator of ``v'(t) = (Y' W - Y W') / W^2``), so every piece is monotone in v. A point ``(u0, v0)`` is
+inside when a ray from it towards +u crosses an odd number of pieces (even-odd rule: outer loops, holes and
+islands need no labels). A piece is crossed when ``v0`` lies in its half-open v-range (a shared end point
+counts once) and the piece's ``u`` at ``v = v0`` exceeds ``u0``; that ``u`` comes from the one root of the
+monotone ``v(t) = v0`` (bisection, exact to the last bit of t in float64 here and float32 on the GPU), and
+is skipped when the piece's control hull already lies wholly left or right of ``u0`` (the convex-hull
+property of a rational Bezier curve with positive weights). So the trim boundary is the exact curve at any
+zoom: no polygon, no staircase.
+"""
+
+from __future__ import annotations
+
+from math import comb
+
+import numpy as np
+
+__all__ = ["TrimPieces", "trim_pieces", "inside", "MAX_TRIM_DEGREE", "PIECE_FLOATS"]
+
+#: Highest trim-curve degree the per-fragment test handles.
+MAX_TRIM_DEGREE = 3
+#: Floats per piece in the GPU table (8 texels: a record never straddles a table row): 4 homogeneous control
+#: points (u w, v w, w, pad), the hull's bbox, the degree, padding.
+PIECE_FLOATS = 32
+
+
+class TrimPieces:
+    """All pieces of a model: ``ctrl`` (n, 4, 3) homogeneous control points (unused rows zero), ``degree``
+    (n,), ``bbox`` (n, 4) = (umin, umax, vmin, vmax) of the hull, and ``start``/``count`` per patch.
+
+    >>> from splinevis.nurbs.model import TrimCurve
+    >>> square = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in
+    ...           [((0.2, 0.2), (0.8, 0.2)), ((0.8, 0.2), (0.8, 0.8)), ((0.8, 0.8), (0.2, 0.8)), ((0.2, 0.8), (0.2, 0.2))]]
+    >>> p = trim_pieces([[square], None])
+    >>> p.count.tolist(), p.start.tolist()  # 4 lines for patch 0 (2 of them horizontal), none for patch 1
+    ([4, 0], [0, 4])
+    """
+
+    def __init__(self, ctrl, degree, bbox, start, count):
+        self.ctrl, self.degree, self.bbox = ctrl, degree, bbox
+        self.start, self.count = start, count
+
+    def table(self) -> np.ndarray:
+        """``(n, PIECE_FLOATS)`` float64 rows: 4 control points x (uw, vw, w, 0), bbox, degree, zeros.
+
+        >>> TrimPieces(np.zeros((1, 4, 3)), np.array([1]), np.zeros((1, 4)), np.zeros(1), np.ones(1)).table().shape
+        (1, 32)
+        """
+        n = len(self.degree)
+        t = np.zeros((n, PIECE_FLOATS))
+        t[:, :16] = np.concatenate([self.ctrl, np.zeros((n, 4, 1))], axis=2).reshape(n, 16)
+        t[:, 16:20] = self.bbox
+        t[:, 20] = self.degree
+        return t
+
+
+def _bezier_segments(curve):
+    """Homogeneous Bezier segments (k, p+1, 3) of a TrimCurve by knot insertion."""
+    p, U = curve.degree, list(curve.knots)
+    w = np.ones(len(curve.control_points)) if curve.weights is None else curve.weights
+    Pw = np.column_stack([curve.control_points * w[:, None], w])
+    lo, hi = U[p], U[len(Pw)]
+    for x in sorted(set(k for k in U if lo <= k <= hi)):  # the domain's ends too (unclamped knots)
+        while U.count(x) < p:  # A5.1 one insertion at a time
+            # the span holding x; the domain's right end is inserted from the left (its span to the right may
+            # have no control points of its own)
+            k = int(np.searchsorted(U, x, side="left" if x == hi else "right")) - 1
+            Q = np.empty((len(Pw) + 1, 3))
+            Q[: k - p + 1] = Pw[: k - p + 1]
+            Q[k + 1:] = Pw[k:]
+            for i in range(k - p + 1, k + 1):
+                a = (x - U[i]) / (U[i + p] - U[i])
+                Q[i] = a * Pw[i] + (1 - a) * Pw[i - 1]
+            Pw, U = Q, U[: k + 1] + [x] + U[k + 1:]
+    first = int(np.searchsorted(U, lo, side="right")) - 1 - p  # the segment starting at the domain's start
+    nseg = len(set(k for k in U if lo <= k <= hi)) - 1
+    return np.asarray([Pw[first + s * p: first + s * p + p + 1] for s in range(nseg)])
+
+
+def _split(seg, t):
+    """De Casteljau split of a homogeneous Bezier segment at t: (left, right)."""
+    pts = [seg]
+    while len(pts[-1]) > 1:
+        prev = pts[-1]
+        pts.append((1 - t) * prev[:-1] + t * prev[1:])
+    return np.array([q[0] for q in pts]), np.array([q[-1] for q in pts[::-1]])
+
+
+def _v_turns(seg) -> list:
+    """Parameters in (0, 1) where v(t) = Y/W turns: real roots of Y' W - Y W' (power basis)."""
+    p = len(seg) - 1
+    M = np.array([[comb(p, i) * comb(p - i, k - i) * (-1) ** (k - i) if k >= i else 0 for i in range(p + 1)]
+                  for k in range(p + 1)], dtype=np.float64)  # power coefficients a_k of t^k from Bernstein
+    Y, W = M @ seg[:, 1], M @ seg[:, 2]
+    Pn = np.polynomial.polynomial
+    num = Pn.polysub(Pn.polymul(Pn.polyder(Y), W), Pn.polymul(Y, Pn.polyder(W)))
+    num = np.trim_zeros(num, "b")
+    if num.size <= 1:
+        return []
+    roots = Pn.polyroots(num)
+    return sorted(float(r.real) for r in roots if abs(r.imag) < 1e-12 and 1e-12 < r.real < 1 - 1e-12)
+
+
+def trim_pieces(trims) -> TrimPieces:
+    """Pieces of every patch's loops (``trims``: per patch None or a list of loops of TrimCurve).
+
+    >>> from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net
+    >>> from splinevis.nurbs.model import TrimCurve
+    >>> xy, w = circle_net()
+    >>> p = trim_pieces([[[TrimCurve(2, CIRCLE_KNOTS, 0.5 + 0.3 * xy, w)]]])
+    >>> p.count.tolist(), p.degree.tolist()  # 4 quarter arcs, monotone in v already (v turns at their joints)
+    ([4], [2, 2, 2, 2])
+    """
+    ctrl, degree, bbox, start, count = [], [], [], [], []
+    for loops in trims:
+        start.append(len(degree))
+        n0 = len(degree)
+        for loop in loops or ():
+            for curve in loop:
+                if curve.degree > MAX_TRIM_DEGREE:
+                    raise ValueError(f"trim curve of degree {curve.degree}: the per-fragment trim test handles degree "
+                                     f"<= {MAX_TRIM_DEGREE}; reduce it (e.g. approximate the loop) before drawing.")
+                for seg in _bezier_segments(curve):
+                    cuts = _v_turns(seg)
+                    rest, done = seg, 0.0
+                    for t in cuts:
+                        left, rest = _split(rest, (t - done) / (1 - done))
+                        done = t
+                        _add(left, ctrl, degree, bbox)
+                    _add(rest, ctrl, degree, bbox)
+        count.append(len(degree) - n0)
+    n = len(degree)
+    return TrimPieces(np.asarray(ctrl, dtype=np.float64).reshape(n, 4, 3), np.asarray(degree, dtype=np.int64),
+                      np.asarray(bbox, dtype=np.float64).reshape(n, 4), np.asarray(start), np.asarray(count))
+
+
+def _add(seg, ctrl, degree, bbox):
+    pts = seg[:, :2] / seg[:, 2:3]
+    c = np.zeros((4, 3))
+    c[: len(seg)] = seg
+    ctrl.append(c)
+    degree.append(len(seg) - 1)
+    bbox.append([pts[:, 0].min(), pts[:, 0].max(), pts[:, 1].min(), pts[:, 1].max()])
+
+
+def _eval(ctrl, deg, t):
+    """Rational Bezier points (m, 2) of pieces (m, 4, 3) with degrees (m,) at t (m,) (de Casteljau)."""
+    out = np.empty((len(t), 3))
+    for p in np.unique(deg):
+        sel = deg == p
+        q = ctrl[sel, : p + 1].copy()
+        tt = t[sel][:, None]
+        for r in range(p):
+            q = (1 - tt[:, None]) * q[:, :-1] + tt[:, None] * q[:, 1:]
+        out[sel] = q[:, 0]
+    return out[:, :2] / out[:, 2:3]
+
+
+def inside(pieces: TrimPieces, patch: int, u, v, iterations: int = 60) -> np.ndarray:
+    """Even-odd inside test of parameters ``(u, v)`` of patch ``patch`` (True everywhere for an untrimmed patch).
+
+    >>> from splinevis.nurbs.model import TrimCurve
+    >>> from splinevis.nurbs.exact import circle_net, CIRCLE_KNOTS
+    >>> xy, w = circle_net()
+    >>> hole = [TrimCurve(2, CIRCLE_KNOTS, 0.5 + 0.3 * xy, w)]
+    >>> border = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in
+    ...           [((0, 0), (1, 0)), ((1, 0), (1, 1)), ((1, 1), (0, 1)), ((0, 1), (0, 0))]]
+    >>> p = trim_pieces([[border, hole]])
+    >>> inside(p, 0, [0.5, 0.5 + 0.2999, 0.5 + 0.3001, 0.05], [0.5, 0.5, 0.5, 0.05]).tolist()
+    [False, False, True, True]
+    """
+    u = np.atleast_1d(np.asarray(u, dtype=np.float64))
+    v = np.atleast_1d(np.asarray(v, dtype=np.float64))
+    s, c = int(pieces.start[patch]), int(pieces.count[patch])
+    if c == 0:
+        return np.ones(u.shape, dtype=bool)
+    ctrl, deg, box = pieces.ctrl[s: s + c], pieces.degree[s: s + c], pieces.bbox[s: s + c]
+    first = ctrl[np.arange(c), 0, 1] / ctrl[np.arange(c), 0, 2]
+    last = ctrl[np.arange(c), deg, 1] / ctrl[np.arange(c), deg, 2]
+    lo, hi = np.minimum(first, last), np.maximum(first, last)
+    U, V = u[:, None], v[:, None]
+    spans = (V >= lo) & (V < hi)  # half-open: a vertex shared by two pieces is counted once
+    sure = spans & (box[:, 0] > U)  # the whole hull right of u0
+    unsure = spans & ~sure & (box[:, 1] > U)
+    crossings = sure.sum(axis=1)
+    pi, pk = np.nonzero(unsure)
+    if pi.size:
+        up = last[pk] > first[pk]
+        a, b = np.zeros(pi.size), np.ones(pi.size)
+        for _ in range(iterations):  # bisection on the monotone v(t) = v0
+            m = 0.5 * (a + b)
+            vm = _eval(ctrl[pk], deg[pk], m)[:, 1]
+            below = (vm < v[pi]) == up
+            a, b = np.where(below, m, a), np.where(below, b, m)
+        um = _eval(ctrl[pk], deg[pk], 0.5 * (a + b))[:, 0]
+        np.add.at(crossings, pi, (um > u[pi]).astype(int))
+    return crossings % 2 == 1

@@ -1,0 +1,36 @@
+"""Seams of multi-patch models classified G0/G1/G2 with known answers (graphs of polynomials joined at x = 0)."""
+
+import numpy as np
+import pytest
+
+from datasets_synthetic.nurbs_joins import joined_pair
+from splinevis.nurbs.continuity import find_seams, seam_lines
+
+
+@pytest.mark.parametrize("join, level", [("G2", "G2"), ("G1", "G1"), ("G0", "G0"), ("gap", "open")])
+def test_known_joins_are_classified(join, level):
+    a = 0.5
+    seams = find_seams(joined_pair(join, a))
+    assert len(seams) == 1
+    s = seams[0]
+    assert s.level == level and {s.side_a, s.side_b} == {"u=u1", "u=u0"}
+    # known values at the seam x = 0: z' of A is 0, z'' of A is 2a (kappa = 2a across the seam, along x)
+    if join == "G2":
+        assert s.gap.max() == 0 and s.angle.max() < 1e-9 and s.curvature_jump.max() < 1e-12
+    if join == "G1":
+        assert s.angle.max() < 1e-9 and s.curvature_jump == pytest.approx(4 * a, rel=1e-12)
+    if join == "G0":  # slopes 0 and a: angle atan(a)
+        assert s.angle == pytest.approx(np.degrees(np.arctan(a)), rel=1e-12)
+    if join == "gap":
+        assert s.gap == pytest.approx(0.02, rel=1e-12)
+
+
+def test_unrelated_patches_have_no_seam_and_lines_carry_classes():
+    A, _ = joined_pair("G2")
+    _, far = joined_pair("G1")
+    from splinevis.nurbs.surface import NurbsSurface
+
+    moved = NurbsSurface(far.degree, far.knots, far.control_points + [5.0, 0.0, 0.0])
+    assert find_seams([A, moved]) == []
+    lines = seam_lines(find_seams(joined_pair("G1")) + find_seams(joined_pair("G2")))
+    assert sorted(set(lines.point_data["level"].tolist())) == [0, 1]
