@@ -85,9 +85,10 @@ def find_span(p: int, U: np.ndarray, u) -> np.ndarray:
     u = np.asarray(u, dtype=np.float64)
     n = U.size - p - 2
     lo, hi = U[p], U[n + 1]
-    if u.size and (np.nanmin(u) < lo or np.nanmax(u) > hi or np.isnan(u).any()):
+    if u.size and (np.isnan(u).any() or u.min() < lo or u.max() > hi):
         bad = u[(u < lo) | (u > hi) | np.isnan(u)].ravel()[0]
-        raise ValueError(f"parameter {float(bad)!r} is outside the knot domain [{float(lo)!r}, {float(hi)!r}].")
+        raise ValueError(f"parameter {float(bad)!r} is outside the knot domain [{float(lo)!r}, {float(hi)!r}]; "
+                         "clamp or rescale the parameters into the domain.")
     span = np.searchsorted(U, u, side="right") - 1
     return np.clip(span, p, n)
 

@@ -232,8 +232,11 @@ def _unit_normal(SKL: np.ndarray, with_mask: bool = False):
     Su, Sv = SKL[:, 1, 0], SKL[:, 0, 1]
     n = np.cross(Su, Sv)
     size = np.linalg.norm(n, axis=-1)
-    scale = np.linalg.norm(Su, axis=-1) * np.linalg.norm(Sv, axis=-1)
-    degenerate = size <= 1e-12 * np.maximum(scale, np.finfo(float).tiny) + (scale == 0)
+    # degenerate when |S_u x S_v| is negligible against the larger tangent squared: a vanishing tangent
+    # (a pole) is rounding noise of the size eps |P| in float64, whose direction is arbitrary, so a
+    # test relative to |S_u| |S_v| would take that noise for a tangent
+    scale = np.maximum(np.linalg.norm(Su, axis=-1), np.linalg.norm(Sv, axis=-1)) ** 2
+    degenerate = size <= 1e-12 * scale + (scale == 0)
     if degenerate.any():
         Suu, Suv, Svv = SKL[degenerate, 2, 0], SKL[degenerate, 1, 1], SKL[degenerate, 0, 2]
         a, b = Su[degenerate], Sv[degenerate]
