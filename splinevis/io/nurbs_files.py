@@ -1,0 +1,97 @@
+"""NURBS models from CAD and spline files, as one :class:`~splinevis.nurbs.NurbsModel`.
+
+:func:`read_nurbs` picks the reader by the file name extension:
+
+* ``.3dm`` -- Rhino files through ``rhino3dm`` (:mod:`.nurbs_3dm`),
+* ``.igs .iges`` -- IGES 128 (rational B-spline surface) and 144 (trimmed surface) through OpenCASCADE
+  (``OCP``, the optional extra ``pip install cadquery-ocp-novtk``) when installed, else ``pyiges``
+  (:mod:`.nurbs_iges`),
+* ``.stp .step`` -- STEP B-spline faces through OCP only (:mod:`.nurbs_step`),
+* ``.g2`` (splipy / GoTools), ``.json`` (geomdl ``shape.data``) and ``.bpt`` (Newell's teapot Bezier
+  patches) -- text formats (:mod:`.nurbs_text`).
+
+Conventions kept by every reader
+--------------------------------
+* Each patch keeps its identity: ``NurbsSurface.name`` is the file's object name or id (Rhino), the
+  entity label or directory sequence number (IGES), the face's index (STEP), the patch index (text).
+* Trim loops come in the patch's own ``(u, v)`` domain, as lists of :class:`~splinevis.nurbs.TrimCurve`;
+  the model applies the even-odd rule, so loop orientation does not matter.
+* Entities the reader does not turn into surfaces are counted in ``NurbsModel.skipped`` (entity type ->
+  count), named in ``NurbsModel.source`` and announced with a :class:`UserWarning`. A file with no
+  supported surface at all raises a ValueError listing what it contained.
+* Invalid data (zero or negative weights, bad knots) raise the model's ValueError prefixed with the file
+  and the entity.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..nurbs import NurbsModel
+from ._common import require_regular_file, unsupported_extension
+
+__all__ = ["read_nurbs", "NURBS_EXTENSIONS"]
+
+#: File name extensions :func:`read_nurbs` reads, and by what.
+NURBS_EXTENSIONS = {
+    ".3dm": "Rhino 3DM (rhino3dm)",
+    ".igs": "IGES 128/144 (OCP, else pyiges)",
+    ".iges": "IGES 128/144 (OCP, else pyiges)",
+    ".stp": "STEP B-spline faces (OCP)",
+    ".step": "STEP B-spline faces (OCP)",
+    ".g2": "GoTools/splipy G2 text",
+    ".json": "geomdl JSON (shape.data)",
+    ".bpt": "Bezier patches (Newell teapot format)",
+}
+
+
+def read_nurbs(path) -> NurbsModel:
+    """Read a NURBS model from a file; the reader is chosen by the extension (see :data:`NURBS_EXTENSIONS`).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    NurbsModel
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        A missing file, an unsupported extension, a file without any supported surface, invalid data.
+    ImportError
+        A STEP file without OCP installed.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     f = Path(folder) / "quad.bpt"
+    ...     _ = f.write_text("1\\n1 1\\n0 0 0\\n0 1 0\\n1 0 0\\n1 1 1\\n")
+    ...     m = read_nurbs(f)
+    >>> len(m), m.names, m.surfaces[0].evaluate([1.0], [1.0]).tolist()
+    (1, ('patch 0',), [[1.0, 1.0, 1.0]])
+    >>> read_nurbs("model.obj")
+    Traceback (most recent call last):
+    ValueError: model.obj: extension '.obj' is not supported; supported: .3dm (Rhino 3DM (rhino3dm)), ...
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"read_nurbs takes a file name, got {type(path).__name__}.")
+    path = Path(path)
+    ext = path.suffix.lower()
+    if ext not in NURBS_EXTENSIONS:
+        raise unsupported_extension(path, NURBS_EXTENSIONS)
+    require_regular_file(path, "NURBS")
+    if ext == ".3dm":
+        from .nurbs_3dm import read_3dm
+        return read_3dm(path)
+    if ext in (".igs", ".iges"):
+        from .nurbs_iges import read_iges
+        return read_iges(path)
+    if ext in (".stp", ".step"):
+        from .nurbs_step import read_step
+        return read_step(path)
+    from .nurbs_text import read_bpt, read_g2, read_geomdl_json
+    return {".g2": read_g2, ".json": read_geomdl_json, ".bpt": read_bpt}[ext](path)
