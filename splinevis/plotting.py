@@ -213,6 +213,24 @@ class Plotter(pv.Plotter):
             program.on_add(actor, self, **(add_options or {}))
         return actor
 
+    def add_nurbs(self, model, style: Style | None = None, **options):
+        """Draw a NURBS model evaluated per fragment [Kanai2007] (see :meth:`add_spline` for ``options``).
+
+        ``model`` is a :class:`~splinevis.nurbs.NurbsModel`, a :class:`~splinevis.nurbs.NurbsSurface`, a list
+        of surfaces or a file :func:`splinevis.io.read_nurbs` reads (.3dm, .igs, .stp, .g2, .json, .bpt).
+        Returns the :class:`SplineActor`; its ``model`` is the NurbsModel.
+
+        Examples
+        --------
+        >>> from splinevis.nurbs.exact import torus
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> actor = pl.add_nurbs(torus(), reflection_lines=8)
+        >>> actor.model.names, bool(pl.screenshot().std() > 10)
+        (('torus',), True)
+        >>> pl.close()
+        """
+        return self._add_from("nurbs", (model,), None, style, options)
+
     def render(self) -> None:
         """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`.
 

@@ -8,7 +8,7 @@ Examples
 --------
 >>> from splinevis import programs
 >>> [p.name for p in programs.all_programs()]
-['analytic_patch', 'terrain', 'isosurface']
+['analytic_patch', 'terrain', 'isosurface', 'nurbs']
 >>> programs.get("terrain").kind
 'raycast'
 """
@@ -22,7 +22,8 @@ from .gl.contract import SplineProgram
 __all__ = ["BUILTIN", "register", "unregister", "all_programs", "get", "program_for"]
 
 #: Modules whose ``PROGRAM`` is a built-in family, in listing order.
-BUILTIN = ("splinevis.analytic.program", "splinevis.terrain.program", "splinevis.volume.program")
+BUILTIN = ("splinevis.analytic.program", "splinevis.terrain.program", "splinevis.volume.program",
+           "splinevis.nurbs.program")
 
 _programs: dict[str, SplineProgram] = {}
 _loaded = False
@@ -85,7 +86,7 @@ def unregister(name: str) -> None:
     False
     >>> unregister("dots")
     Traceback (most recent call last):
-    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface."
+    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface, nurbs."
     """
     _load_builtin()
     if name not in _programs:
@@ -99,7 +100,7 @@ def all_programs() -> list[SplineProgram]:
     Examples
     --------
     >>> [(p.name, p.kind) for p in all_programs()]
-    [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast')]
+    [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast'), ('nurbs', 'surface')]
     """
     _load_builtin()
     return list(_programs.values())

@@ -445,8 +445,8 @@ def program_hard_cases(progress: bool = True, *, only=None) -> dict:
     from .analysis.agreement import agreement_failures, hard_case_agreement
     from .programs import all_programs
 
-    cases = [(p.name, c) for p in all_programs() if p.kind == "raycast" and p.hard_cases is not None
-             for c in p.hard_cases() if only is None or f"{p.name}/{c.name}" in only]
+    cases = [(p.name, c) for p in all_programs() if p.reference is not None and p.depth_bound is not None
+             and p.hard_cases is not None for c in p.hard_cases() if only is None or f"{p.name}/{c.name}" in only]
     out: dict = {}
     for name, case in tqdm(cases, disable=not progress, desc="hard cases", unit="case"):
         r = hard_case_agreement(case)

@@ -35,3 +35,28 @@ def test_dem_example_reads_a_dem_and_draws_reflection_lines(tmp_path):
     assert non_white.mean() > 0.5
     dark = np.all(img < 50, axis=-1)
     assert 0.1 < dark.mean() < 0.6  # stripes, not a black or empty picture
+
+
+@pytest.mark.gl
+def test_nurbs_zebra_example_writes_zebra_and_curvature(tmp_path):
+    out = tmp_path / "zebra.png"
+    res = subprocess.run([sys.executable, str(ROOT / "examples/nurbs_zebra.py"), "", str(out)], check=True,
+                         capture_output=True, text=True, cwd=ROOT)
+    assert "1 patches" in res.stdout
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    left, right = img[:, : img.shape[1] // 2], img[:, img.shape[1] // 2:]
+    assert np.all(left < 60, axis=-1).sum() > 3000  # dark zebra stripes
+    reddish = (right[..., 0] > right[..., 2] + 40).sum()
+    bluish = (right[..., 2] > right[..., 0] + 40).sum()
+    assert reddish + bluish > 3000  # curvature colours, not a white panel
+
+
+@pytest.mark.gl
+def test_nurbs_quality_report_finds_the_edited_patch(tmp_path):
+    res = subprocess.run([sys.executable, str(ROOT / "examples/nurbs_quality_report.py"), "", str(tmp_path)],
+                         check=True, capture_output=True, text=True, cwd=ROOT)
+    md = (tmp_path / "report.md").read_text()
+    # 25 Bezier patches of a 5 x 5 knot grid: 40 seams; the edited patch's four seams are not G1
+    assert "25 patches, 40 seams; 36 G2, 0 G1, 4 G0, 0 open." in md, res.stdout
+    img = np.asarray(Image.open(tmp_path / "report.png").convert("RGB")).astype(int)
+    assert img.std() > 30

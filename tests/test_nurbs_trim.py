@@ -86,7 +86,8 @@ def test_glsl_trim_test_matches_the_twin_and_has_no_staircase_at_1000x_zoom():
     uv = np.vstack([uv, np.column_stack([zu.ravel(), zv.ravel()])]).astype(np.float32).astype(np.float64)
     body = "sv_out[0] = sv_trim_inside(0, int(sv_in[2]), vec2(sv_in[0], sv_in[1])) ? 1.0 : 0.0;"
     inputs = np.column_stack([uv, np.full(len(uv), p.count[0])])
-    gpu = run_glsl('#include "lib/core/table.glsl"\n#include "lib/nurbs/trim.glsl"\n', body, inputs, 1,
+    functions = 'uniform sampler2D sv_trim_table;\n#include "lib/core/table.glsl"\n#include "lib/nurbs/trim.glsl"\n'
+    gpu = run_glsl(functions, body, inputs, 1,
                    tables={"sv_trim_table": table})[:, 0] > 0.5
     want = inside(p, 0, uv[:, 0], uv[:, 1])
     r = np.hypot(uv[:, 0] - 0.5, uv[:, 1] - 0.5)

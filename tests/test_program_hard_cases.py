@@ -11,12 +11,14 @@ from splinevis.analysis.agreement import agreement_failures, hard_case_agreement
 
 pytestmark = pytest.mark.gl
 
-CASES = [(p.name, case) for p in programs.all_programs() if p.kind == "raycast" and p.hard_cases is not None
-         for case in p.hard_cases()]
+# every program with a float64 twin (ray-cast proxies and per-fragment surface evaluation alike)
+TWINNED = [p for p in programs.all_programs() if p.reference is not None and p.depth_bound is not None]
+CASES = [(p.name, case) for p in TWINNED if p.hard_cases is not None for case in p.hard_cases()]
 
 
-def test_every_raycast_program_declares_hard_cases():
-    names = {p.name for p in programs.all_programs() if p.kind == "raycast"}
+def test_every_program_with_a_twin_declares_hard_cases():
+    names = {p.name for p in TWINNED}
+    assert {p.name for p in programs.all_programs() if p.kind == "raycast"} <= names
     assert names == {name for name, _ in CASES}
 
 

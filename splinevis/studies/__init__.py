@@ -11,7 +11,7 @@ scheme is not available), is listed by :func:`notes`.
 Examples
 --------
 >>> sorted(STUDIES)
-['terrain', 'volume']
+['nurbs', 'terrain', 'volume']
 >>> STUDIES["volume"].runner
 'splinevis.studies.volume:run_volume_study'
 """
@@ -80,6 +80,8 @@ STUDIES = {s.name: s for s in (
           "terrain splines of Franke's function against triangle meshes"),
     Study("volume", "splinevis.studies.volume:run_volume_study",
           "isosurface splines against marching cubes and VTK's volume ray caster"),
+    Study("nurbs", "splinevis.studies.nurbs:run_nurbs_study",
+          "NURBS zebra stripes per fragment against tessellated meshes (ours and OpenCASCADE's)"),
 )}
 
 
@@ -98,7 +100,7 @@ def get(name: str) -> Study:
     >>> get("sphere")
     Traceback (most recent call last):
     ...
-    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume'.
+    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs'.
     """
     try:
         return STUDIES[name]

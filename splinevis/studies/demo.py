@@ -115,7 +115,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _effect_panels()
-    steps = progress_bar(total=4 + len(panels), desc="showcase", enabled=progress, unit="fig")
+    steps = progress_bar(total=5 + len(panels), desc="showcase", enabled=progress, unit="fig")
     written = {}
 
     pl, patch, _ = composite_scene()
@@ -167,6 +167,10 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     path = out / "volume.png"
     side_by_side_figure(path)
     written["volume"] = path
+    steps.update()
+    from .nurbs_demo import nurbs_figure
+
+    written["nurbs"] = nurbs_figure(out / "nurbs.png")
     steps.update()
     steps.close()
     return written

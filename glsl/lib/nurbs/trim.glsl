@@ -4,7 +4,7 @@
 // Float64 twin and the derivation of the pieces: splinevis/nurbs/trim.py. Table layout: 8 texels per piece
 // (splinevis.nurbs.trim.PIECE_FLOATS): 4 homogeneous control points (u w, v w, w, -), the hull's
 // (umin, umax, vmin, vmax), (degree, -, -, -), one texel of padding.
-uniform sampler2D sv_trim_table;
+// The sampler sv_trim_table is declared by VTK for the actor's texture (a harness declares it itself).
 
 #ifndef SV_MAX_TRIM_PIECES
 #define SV_MAX_TRIM_PIECES 4096

@@ -1,0 +1,261 @@
+"""The NURBS study: zebra stripes from a tessellated mesh with interpolated normals against per-fragment
+evaluation [Kanai2007, sec. 4, Fig. 3], as numbers and figures, and what the fragment program's frame time
+depends on.
+
+* **Accuracy against time** (``pareto``): the hood panel's reflection lines per pixel against the float64
+  twin's exact ones (the twin ray-casts the surface and mirrors the view ray about its exact normal).
+  Error = share of surface pixels whose stripe colour differs (pixels within a stated margin of an exact
+  stripe edge are left out), and the mean stripe displacement in pixels (wrong pixels per pixel of exact
+  stripe edge). Rows: our tessellation at 1..64 quads per knot span (exact vertex normals, interpolated),
+  OpenCASCADE's tessellation at deflections 1e-2..1e-5 of the model size when ``OCP`` is installed, and the
+  per-fragment program; each with its median frame time, measured in the same run.
+* **Frame time against patch count** (1, 32, 1 024 and, unless quick, 10 000 bicubic tiles covering the same
+  square) and **against degree** (1..7, one patch), with the texture memory of each program.
+
+The markdown says, for this machine, at which accuracy the per-fragment program beats the finest mesh that
+reaches it (or that none does).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .report import clean, log, md_table, progress_bar, pyplot, save_figure, timed, write_json
+
+__all__ = ["run_nurbs_study", "zebra_reference", "zebra_error", "PARETO_CAMERA"]
+
+PARETO_CAMERA = [(1.0, -1.6, 1.5), (1.0, 0.5, 0.1), (0.0, 0.0, 1.0)]
+STRIPES = 10
+AXIS = (0.0, 1.0, 0.0)
+#: A pixel's stripe phase may move by the float32 normal error of the program (~1e-5 rad) and by the ray
+#: through the pixel centre against the fragment's sample; pixels whose exact phase lies within this many
+#: stripe widths of an edge are not counted (both colours are right there).
+EDGE_MARGIN = 0.02
+
+
+def _program():
+    from ..programs import get
+
+    return get("nurbs")
+
+
+def zebra_reference(model, matrix, window, stripes=STRIPES, axis=AXIS):
+    """The exact stripe colour per pixel (True bright) from the float64 twin, the hit mask and each pixel's
+    distance to the nearest stripe edge in stripe widths.
+    """
+    from ..effects import line_frame
+    from ..gl.camera import pixel_rays
+
+    w, h = window
+    o, d = pixel_rays(matrix, w, h)
+    hits = _program().raycast(model, o, d, 0.0)
+    rd = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    n = hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
+    n = np.where((np.einsum("...i,...i", n, rd) > 0)[..., None], -n, n)
+    r = rd - 2 * np.einsum("...i,...i", rd, n)[..., None] * n
+    b, c = (np.asarray(v) for v in line_frame(axis))
+    x = np.arctan2(r @ b, r @ c) / np.pi * stripes
+    f = x - np.floor(x)
+    return f >= 0.5, hits.hit, np.minimum(np.abs(f - 0.5), np.minimum(f, 1 - f))
+
+
+def zebra_error(image, reference) -> dict:
+    """Share of wrongly coloured surface pixels (in %) and mean stripe displacement (pixels) of a rendered
+    zebra ``image`` (H, W, 3 floats in [0, 1]) against :func:`zebra_reference`.
+
+    >>> bright = np.array([[True, False], [True, True]])
+    >>> ref = (bright, np.ones((2, 2), bool), np.full((2, 2), 0.25))
+    >>> img = np.stack([bright.astype(float)] * 3, axis=-1)
+    >>> zebra_error(img, ref)["wrong_pct"]
+    0.0
+    """
+    bright, hit, dist = reference
+    counted = hit & (dist > EDGE_MARGIN) & (image.sum(-1) > 0.05)
+    got = image[..., 0] > 0.5 * image[..., 0][hit].max()
+    wrong = counted & (got != bright)
+    edges = hit & ((np.diff(bright, axis=0, prepend=bright[:1]) != 0) | (np.diff(bright, axis=1, prepend=bright[:, :1]) != 0))
+    return {"wrong_pct": 100.0 * wrong.sum() / max(counted.sum(), 1), "displacement_px": wrong.sum() / max(edges.sum(), 1),
+            "pixels": int(counted.sum())}
+
+
+def _scene(window, camera):
+    from ..plotting import Plotter
+
+    pl = Plotter(off_screen=True, window_size=window)
+    pl.set_background("black")
+    return pl
+
+
+def _finish(pl, camera, repeats):
+    pl.camera_position = camera
+    pl.camera.clipping_range = (0.5, 10.0)
+    img = pl.screenshot().astype(np.float64) / 255.0
+    matrix = pl.camera_matrix()
+    row = timed(pl, repeats, with_repeats=False)
+    pl.close()
+    return img, matrix, row
+
+
+def _render_spline(model, window, camera, repeats):
+    pl = _scene(window, camera)
+    pl.add_nurbs(model, lights=0, color=(1.0, 1.0, 1.0), reflection_lines=STRIPES, reflection_axis=AXIS)
+    return _finish(pl, camera, repeats)
+
+
+def _render_mesh(mesh, window, camera, repeats):
+    from ..gl.mesh_effects import add_mesh_with_reflection_lines
+
+    pl = _scene(window, camera)
+    add_mesh_with_reflection_lines(pl, mesh, STRIPES, color=(1.0, 1.0, 1.0), ambient=1.0, diffuse=0.0, axis=AXIS)
+    return _finish(pl, camera, repeats)
+
+
+def pareto_rows(model, *, window, densities, deflections, repeats, progress=True):
+    """Rows of the accuracy-against-time comparison (module docstring)."""
+    from ..nurbs.tessellate import chord_deviation, tessellate
+    from .nurbs_occ import occ_available, occ_tessellate
+
+    img, matrix, t_spline = _render_spline(model, window, PARETO_CAMERA, repeats)
+    ref = zebra_reference(model, matrix, window)
+    rows = [{"method": "per fragment", "triangles": None, "chord_deviation": 0.0, **t_spline, **zebra_error(img, ref)}]
+    size = float(np.linalg.norm(np.subtract(*np.asarray(model.bounds()).reshape(3, 2).T)))
+    jobs = [("mesh", n) for n in densities] + ([("occ", d) for d in deflections] if occ_available() else [])
+    for kind, param in progress_bar(jobs, "nurbs: meshes", enabled=progress):
+        if kind == "mesh":
+            mesh = tessellate(model, param)
+            label, dev = f"mesh {param}/span", chord_deviation(model, param)
+        else:
+            mesh = occ_tessellate(model, param * size)
+            label, dev = f"OCC deflection {param:g}", param * size
+        img, _, t = _render_mesh(mesh, window, PARETO_CAMERA, repeats)
+        rows.append({"method": label, "triangles": int(mesh.n_cells), "chord_deviation": dev, **t, **zebra_error(img, ref)})
+    return rows
+
+
+def verdict(rows) -> str:
+    """Which is cheaper at the per-fragment program's accuracy: it, or the cheapest mesh at least as accurate.
+
+    >>> verdict([{"method": "per fragment", "wrong_pct": 0.1, "frame_median_ms": 20.0},
+    ...          {"method": "mesh 4/span", "wrong_pct": 3.0, "frame_median_ms": 5.0},
+    ...          {"method": "mesh 64/span", "wrong_pct": 0.1, "frame_median_ms": 30.0}])
+    'At the per-fragment accuracy (0.1 % wrong stripe pixels) the cheapest mesh as accurate is mesh 64/span at 30.0 ms against 20.0 ms per fragment: the per-fragment program is faster (1.5x).'
+    """
+    frag = next(r for r in rows if r["method"] == "per fragment")
+    good = [r for r in rows if r["method"] != "per fragment" and r["wrong_pct"] <= frag["wrong_pct"]]
+    head = f"At the per-fragment accuracy ({frag['wrong_pct']:.1f} % wrong stripe pixels)"
+    if not good:
+        best = min((r for r in rows if r["method"] != "per fragment"), key=lambda r: r["wrong_pct"])
+        return (f"{head} no mesh measured is as accurate (the best, {best['method']}, has {best['wrong_pct']:.1f} % "
+                f"at {best['frame_median_ms']:.1f} ms; per fragment {frag['frame_median_ms']:.1f} ms).")
+    cheap = min(good, key=lambda r: r["frame_median_ms"])
+    ratio = cheap["frame_median_ms"] / frag["frame_median_ms"]
+    who = f"the per-fragment program is faster ({ratio:.1f}x)" if ratio > 1 else f"the mesh is faster ({1 / ratio:.1f}x)"
+    return (f"{head} the cheapest mesh as accurate is {cheap['method']} at {cheap['frame_median_ms']:.1f} ms against "
+            f"{frag['frame_median_ms']:.1f} ms per fragment: {who}.")
+
+
+def _texture_bytes(model) -> int:
+    spec = _program().build(model, None, newton_iterations=_program().newton_iterations)
+    return int(sum(np.asarray(t).nbytes for t in spec.textures.values()))
+
+
+def scaling_rows(*, counts, degrees, window, repeats, progress=True):
+    """Frame time and texture memory against the number of patches and against the degree."""
+    from datasets_synthetic.nurbs_models import degree_patch, patch_tiling
+
+    camera = [(1.0, -1.8, 2.2), (1.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+    out = []
+    jobs = [("patches", c) for c in counts] + [("degree", p) for p in degrees]
+    for kind, k in progress_bar(jobs, "nurbs: scaling", enabled=progress):
+        model = patch_tiling(k) if kind == "patches" else degree_patch(k)
+        t0 = time.perf_counter()
+        pl = _scene(window, camera)
+        pl.add_nurbs(model, lights=1)
+        build = time.perf_counter() - t0
+        _, _, t = _finish(pl, camera, repeats)
+        out.append({"kind": kind, "value": k, "build_s": build, **t, "texture_bytes": _texture_bytes(model)})
+    return out
+
+
+def _figures(out, pareto, scaling):
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for prefix, marker in (("mesh", "o-"), ("OCC", "s-")):
+        rs = [r for r in pareto if r["method"].startswith(prefix)]
+        if rs:
+            ax.plot([r["frame_median_ms"] for r in rs], [max(r["wrong_pct"], 1e-3) for r in rs], marker, label=prefix)
+            for r in rs:
+                ax.annotate(r["method"].split()[-1], (r["frame_median_ms"], max(r["wrong_pct"], 1e-3)), fontsize=7)
+    f = next(r for r in pareto if r["method"] == "per fragment")
+    ax.plot([f["frame_median_ms"]], [max(f["wrong_pct"], 1e-3)], "r*", markersize=14, label="per fragment")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("median frame time (ms)")
+    ax.set_ylabel("wrong zebra pixels (%)")
+    ax.set_title("Zebra stripes: accuracy against time (hood panel)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    save_figure(fig, out / "pareto.png")
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for ax, kind, xl in zip(axes, ("patches", "degree"), ("patches", "degree p = q")):
+        rs = [r for r in scaling if r["kind"] == kind]
+        ax.plot([r["value"] for r in rs], [r["frame_median_ms"] for r in rs], "o-")
+        ax.set_xscale("log" if kind == "patches" else "linear")
+        ax.set_xlabel(xl)
+        ax.set_ylabel("median frame time (ms)")
+        ax.grid(True, alpha=0.3)
+    save_figure(fig, out / "scaling.png")
+
+
+def side_by_side(out, model, window, mesh_density=2):
+    """Zebra stripes of a coarse mesh (interpolated normals) beside the per-fragment program's."""
+    from PIL import Image
+
+    from ..nurbs.tessellate import tessellate
+
+    a, _, _ = _render_mesh(tessellate(model, mesh_density), window, PARETO_CAMERA, 1)
+    b, _, _ = _render_spline(model, window, PARETO_CAMERA, 1)
+    img = np.concatenate([a, np.ones((a.shape[0], 6, 3)), b], axis=1)
+    Image.fromarray((img * 255).astype(np.uint8)).save(out / "zebra_side_by_side.png")
+
+
+def run_nurbs_study(out_dir, *, quick=False, progress=True) -> dict:
+    """Run the study; returns the dict also written to ``out_dir/nurbs.json`` (plus ``nurbs.md``, figures)."""
+    from datasets_synthetic.nurbs_models import hood
+
+    from .nurbs_occ import occ_available
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    window = (320, 240) if quick else (640, 480)
+    repeats = 3 if quick else 7
+    model = hood()
+    result = {"quick": quick, "machine": {"loadavg_1_5_15_at_start": list(os.getloadavg())},
+              "occ": {"available": occ_available(), "note": "OpenCASCADE (OCP) tessellation compared" if occ_available()
+                      else "OpenCASCADE (OCP) not installed: its tessellation is not compared"}}
+    log("nurbs", result["occ"]["note"])
+    pareto = pareto_rows(model, window=window, densities=(1, 2, 4, 8, 16) if quick else (1, 2, 4, 8, 16, 32, 64),
+                         deflections=(1e-2, 1e-3, 1e-4) if quick else (1e-2, 1e-3, 1e-4, 1e-5), repeats=repeats,
+                         progress=progress)
+    result["pareto"], result["verdict"] = pareto, verdict(pareto)
+    scaling = scaling_rows(counts=(1, 32, 1024) if quick else (1, 32, 1024, 10000), degrees=range(1, 8),
+                           window=window, repeats=repeats, progress=progress)
+    result["scaling"] = scaling
+    _figures(out, pareto, scaling)
+    side_by_side(out, model, window)
+    result["seconds"] = time.perf_counter() - t0
+    result["machine"]["loadavg_1_5_15_at_end"] = list(os.getloadavg())
+    result = clean(result)
+    write_json(out / "nurbs.json", result)
+    cols = ["method", "triangles", "chord_deviation", "frame_median_ms", "wrong_pct", "displacement_px"]
+    md = ["# NURBS study: zebra stripes, mesh against per fragment", "", result["verdict"], "",
+          md_table(pareto, cols), "", "## Frame time against patch count and degree", "",
+          md_table(scaling, ["kind", "value", "build_s", "frame_median_ms", "texture_bytes"]), "",
+          "![pareto](pareto.png)", "", "![scaling](scaling.png)", "", "![zebra](zebra_side_by_side.png)", ""]
+    (out / "nurbs.md").write_text("\n".join(md))
+    return result

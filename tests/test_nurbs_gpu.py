@@ -1,0 +1,70 @@
+"""The NURBS fragment program (glsl/programs/nurbs.glsl) against its float64 twin (splinevis/nurbs/raycast.py):
+normals per pixel, silhouettes of a sphere and a torus. The hard cases (depths per pixel within the derived
+bound) run with every other program's in tests/test_program_hard_cases.py."""
+
+import numpy as np
+import pytest
+
+import splinevis
+from splinevis import programs
+from splinevis.gl.camera import pixel_rays
+from splinevis.nurbs.exact import sphere, torus
+from splinevis.nurbs.model import NurbsModel
+from splinevis.nurbs.program import PROGRAM, nurbs_program
+
+pytestmark = pytest.mark.gl
+
+def _render(model, camera, size=(160, 120), **style):
+    pl = splinevis.Plotter(off_screen=True, window_size=size)
+    actor = pl.add_spline(model, **style)
+    pl.camera_position = camera
+    pl.reset_camera_clipping_range()
+    img = pl.screenshot()
+    depth, matrix = pl.depth_buffer(), pl.camera_matrix()
+    pl.close()
+    return actor, img, depth, matrix
+
+
+def test_nurbs_is_registered_as_a_surface_program():
+    program = programs.get("nurbs")
+    assert program is PROGRAM and program.kind == "surface"
+    assert programs.program_for(NurbsModel([sphere()])) is PROGRAM
+    assert PROGRAM.model_from(torus()).names == ("torus",)
+
+
+@pytest.mark.parametrize("name, model, camera", [
+    ("sphere", NurbsModel([sphere()]), [(3.0, -4.0, 2.5), (0, 0, 0), (0, 0, 1)]),
+    ("torus", NurbsModel([torus()]), [(4.0, -5.0, 3.0), (0, 0, 0), (0, 0, 1)]),
+])
+def test_sphere_and_torus_are_drawn_with_the_twins_silhouette(name, model, camera, tmp_path):
+    actor, img, depth, matrix = _render(model, camera, lights=1, color="tan")
+    import imageio
+
+    imageio.imwrite(tmp_path / f"{name}.png", img)
+    assert "sv_surface_eval" in actor.program_sources["fragment"]
+    gpu_hit = depth < 1.0
+    assert gpu_hit.mean() > 0.2 and img[gpu_hit].std() > 10  # shaded, not blank or flat
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref_hit = PROGRAM.raycast(model, o, d).hit
+    assert (gpu_hit != ref_hit).sum() <= 0.001 * gpu_hit.size
+
+
+def test_normals_per_pixel_match_the_twin():
+    model = NurbsModel([torus()])
+    camera = [(4.0, -5.0, 3.0), (0, 0, 0), (0, 0, 1)]
+    _, img, depth, matrix = _render(model, camera, output="normals")
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref = PROGRAM.raycast(model, o, d)
+    both = (depth < 1.0) & ref.hit
+    gpu_n = img[both, :3].astype(float) / 255.0 * 2.0 - 1.0
+    ref_n = ref.normals[both] / np.linalg.norm(ref.normals[both], axis=-1, keepdims=True)
+    cos = np.abs(np.einsum("ij,ij->i", gpu_n / np.linalg.norm(gpu_n, axis=-1, keepdims=True), ref_n))
+    assert both.sum() > 3000
+    assert np.quantile(cos, 0.999) > 0.999 and cos.min() > 0.99  # 8-bit colours: about 1/128 per component
+
+
+def test_options_are_checked():
+    with pytest.raises(ValueError, match="newton_iterations must be 1..16"):
+        nurbs_program(NurbsModel([sphere()]), newton_iterations=0)
+    with pytest.raises(TypeError, match="has no option 'roots'"):
+        PROGRAM.make(NurbsModel([sphere()]), None, roots="paper")
