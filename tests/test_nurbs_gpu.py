@@ -68,3 +68,33 @@ def test_options_are_checked():
         nurbs_program(NurbsModel([sphere()]), newton_iterations=0)
     with pytest.raises(TypeError, match="has no option 'roots'"):
         PROGRAM.make(NurbsModel([sphere()]), None, roots="paper")
+
+
+@pytest.mark.parametrize("kind", ["gaussian", "mean"])
+def test_curvature_per_pixel_matches_the_exact_torus(kind):
+    # torus R = 2, r = 0.5: K = cos(phi) / (r (R + r cos phi)), H = -(R + 2 r cos phi) / (2 r (R + r cos phi))
+    # (outward normal), with cos(phi) = (rho - R) / r at the twin's hit point. The colour encodes value /
+    # scale on a white-red (positive) or white-blue (negative) ramp in 8 bits: decoding the channel that
+    # falls (green 0.98, red 0.77 per unit) is good to 1/255 / 0.77 of the scale; the program's float32
+    # curvature adds far less. The sign of H depends on the normal's orientation: compared in magnitude.
+    R, r = 2.0, 0.5
+    model = NurbsModel([torus(R, r)])
+    scale = 1.5
+    camera = [(4.0, -5.0, 3.0), (0, 0, 0), (0, 0, 1)]
+    _, img, depth, matrix = _render(model, camera, output="curvature", curvature=kind, curvature_scale=scale)
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref = PROGRAM.raycast(model, o, d)
+    from scipy import ndimage
+
+    both = ndimage.binary_erosion((depth < 1.0) & ref.hit, iterations=2)
+    p = ref.points[both]
+    c = (np.hypot(p[:, 0], p[:, 1]) - R) / r
+    want = c / (r * (R + r * c)) if kind == "gaussian" else (R + 2 * r * c) / (2 * r * (R + r * c))
+    col = img[both, :3].astype(float) / 255.0
+    positive = col[:, 2] < col[:, 0]  # red side
+    x = np.where(positive, (1 - col[:, 1]) / 0.98, -(1 - col[:, 0]) / 0.77)
+    got = np.clip(x, -1, 1) * scale
+    ok = np.abs(want) < 0.98 * scale  # not clamped
+    assert both.sum() > 3000 and ok.sum() > 1000
+    err = np.abs((got if kind == "gaussian" else np.abs(got)) - (want if kind == "gaussian" else np.abs(want)))[ok]
+    assert err.max() <= 1.5 / 255 / 0.77 * scale
