@@ -10,20 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.nurbs_step import ocp_available as occ_available
+
 __all__ = ["occ_available", "occ_tessellate"]
-
-
-def occ_available() -> bool:
-    """True when OCP (OpenCASCADE) can be imported.
-
-    >>> isinstance(occ_available(), bool)
-    True
-    """
-    try:
-        import OCP  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def _face(s):
