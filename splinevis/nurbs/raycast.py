@@ -270,26 +270,65 @@ def newton_on_rays(model, patch, uv, origins, directions, iterations: int):
     return uv, res, der
 
 
-def _ray_triangles(o, d, tri_pts, chunk=1024):
-    """All crossings (ray index, triangle index, b1, b2) of rays with triangles (Moller-Trumbore)."""
-    A, B, C = tri_pts[:, 0], tri_pts[:, 1], tri_pts[:, 2]
+def _candidates(o, d, tri_pts):
+    """(ray, triangle) pairs whose ray may cross the triangle: VTK's BSP tree (vtkModifiedBSPTree) finds the
+    triangles each ray's segment through the shell's bounding box meets (with a tolerance of 1e-7 of the box),
+    instead of testing every ray against every triangle."""
+    import vtk
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    n = len(tri_pts)
+    poly = vtk.vtkPolyData()
+    pts = vtk.vtkPoints()
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(tri_pts.reshape(-1, 3)), deep=True))
+    cells = vtk.vtkCellArray()
+    cells.SetData(numpy_to_vtkIdTypeArray(np.arange(0, 3 * n + 1, 3, dtype=np.int64), deep=True),
+                  numpy_to_vtkIdTypeArray(np.arange(3 * n, dtype=np.int64), deep=True))
+    poly.SetPoints(pts)
+    poly.SetPolys(cells)
+    tree = vtk.vtkModifiedBSPTree()
+    tree.SetDataSet(poly)
+    tree.BuildLocator()
+    lo, hi = tri_pts.reshape(-1, 3).min(axis=0), tri_pts.reshape(-1, 3).max(axis=0)
+    size = float(np.linalg.norm(hi - lo)) or 1.0
+    lo, hi = lo - 1e-6 * size, hi + 1e-6 * size
+    with np.errstate(divide="ignore", invalid="ignore"):  # the segment of each line inside the box (slabs)
+        ta, tb = (lo - o) / d, (hi - o) / d
+        t0 = np.nanmax(np.where(d != 0, np.minimum(ta, tb), -np.inf), axis=1)
+        t1 = np.nanmin(np.where(d != 0, np.maximum(ta, tb), np.inf), axis=1)
+    inside = (d == 0) & ((o < lo) | (o > hi))
+    use = (t0 <= t1) & ~inside.any(axis=1)
+    p1, p2 = o + t0[:, None] * d, o + t1[:, None] * d
+    hit_pts, ids = vtk.vtkPoints(), vtk.vtkIdList()
+    rays, tris = [], []
+    for r in np.flatnonzero(use):
+        tree.IntersectWithLine(p1[r].tolist(), p2[r].tolist(), 1e-7 * size, hit_pts, ids)
+        k = ids.GetNumberOfIds()
+        if k:
+            rays.append(np.full(k, r))
+            tris.append([ids.GetId(i) for i in range(k)])
+    if not rays:
+        return np.zeros(0, int), np.zeros(0, int)
+    return np.concatenate(rays), np.concatenate(tris).astype(int)
+
+
+def _ray_triangles(o, d, tri_pts):
+    """All crossings (ray index, triangle index, b1, b2) of rays with triangles (Moller-Trumbore on the
+    candidate pairs of :func:`_candidates`)."""
+    r, t = _candidates(o, d, tri_pts)
+    A, B, C = tri_pts[t, 0], tri_pts[t, 1], tri_pts[t, 2]
     e1, e2 = B - A, C - A
-    out = []
-    for s0 in range(0, len(o), chunk):
-        oo, dd = o[s0: s0 + chunk, None, :], d[s0: s0 + chunk, None, :]
-        pv = np.cross(dd, e2[None])
-        det = np.einsum("rtk,tk->rt", pv, e1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            inv = 1.0 / det
-            tv = oo - A[None]
-            b1 = np.einsum("rtk,rtk->rt", tv, pv) * inv
-            qv = np.cross(tv, e1[None])
-            b2 = np.einsum("rtk,rk->rt", qv, d[s0: s0 + chunk]) * inv
-            tol = 1e-9
-            ok = (det != 0) & (b1 >= -tol) & (b2 >= -tol) & (b1 + b2 <= 1 + tol)
-        r, t = np.nonzero(ok)
-        out.append((r + s0, t, b1[r, t], b2[r, t]))
-    return tuple(np.concatenate(x) for x in zip(*out)) if out else (np.zeros(0, int),) * 2 + (np.zeros(0),) * 2
+    dd = d[r]
+    pv = np.cross(dd, e2)
+    det = np.einsum("ik,ik->i", pv, e1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / det
+        tv = o[r] - A
+        b1 = np.einsum("ik,ik->i", tv, pv) * inv
+        b2 = np.einsum("ik,ik->i", np.cross(tv, e1), dd) * inv
+        tol = 1e-9
+        ok = (det != 0) & (b1 >= -tol) & (b2 >= -tol) & (b1 + b2 <= 1 + tol)
+    return r[ok], t[ok], b1[ok], b2[ok]
 
 
 def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
