@@ -430,7 +430,7 @@ def _test_roots(rng, m, n, iterations, results, method="newton4"):
 
 
 def program_hard_cases(progress: bool = True, *, only=None) -> dict:
-    """Every registered ray-cast program (:mod:`splinevis.programs`) on the hard cases it declares, GPU against
+    """Every registered program with a float64 twin (:mod:`splinevis.programs`) on the hard cases it declares, GPU against
     its float64 twin per pixel (:func:`splinevis.analysis.agreement.hard_case_agreement`); ``only``: the
     ``"program/case"`` names to run (default all).
 
