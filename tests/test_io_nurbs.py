@@ -400,3 +400,28 @@ def test_dispatch_errors(tmp_path):
     bad.write_text("{")
     with pytest.raises(ValueError, match="bad.json: not valid JSON"):
         read_nurbs(bad)
+
+
+def test_step_reversed_faces_are_flipped_so_every_box_normal_points_out(tmp_path):
+    # a box's faces come half REVERSED in OpenCASCADE: read back, each face's S_u x S_v must point away from
+    # the box centre (known answer), which needs the reversed ones mirrored in v (trims with them)
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    box = BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeBox(2.0, 1.0, 1.0).Shape(), True).Shape()
+    writer = STEPControl_Writer()
+    writer.Transfer(box, STEPControl_AsIs)
+    path = tmp_path / "box.stp"
+    writer.Write(str(path))
+    model = read_nurbs(path)
+    assert len(model) == 6
+    centre = np.array([1.0, 0.5, 0.5])
+    for s, loops in zip(model.surfaces, model.trims):
+        (u0, u1), (v0, v1) = s.domain
+        u, v = np.array([(u0 + u1) / 2]), np.array([(v0 + v1) / 3])
+        n, p = s.normal(u, v)[0], s.evaluate(u, v)[0]
+        assert np.dot(n, p - centre) > 0, s.name
+        from splinevis.nurbs.trim import inside, trim_pieces
+
+        assert inside(trim_pieces([loops]), 0, u, v).all()  # the mirrored loops still hold the face's inside

@@ -132,7 +132,7 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
     (['box face 0', 'box face 1'], 1, 4)
     """
     from OCP.BRep import BRep_Tool
-    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
@@ -152,9 +152,33 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
             key = f"face on {kind_name}"
             skipped[key] = skipped.get(key, 0) + 1
             continue
-        surfaces.append(checked(path, name, lambda: bspline_surface(surf, name)))
-        trims.append([_loop(wire, face, path, name) for wire in _wires(face)] or None)
+        surface = checked(path, name, lambda: bspline_surface(surf, name))
+        loops = [_loop(wire, face, path, name) for wire in _wires(face)] or None
+        if face.Orientation() == TopAbs_REVERSED:  # the face's outside is the surface's back: mirror v
+            surface, loops = _flip_v(surface, loops)
+        surfaces.append(surface)
+        trims.append(loops)
     return surfaces, trims
+
+
+def _flip_v(surface: NurbsSurface, loops):
+    """The same surface with v running backwards (so S_u x S_v flips), and its trim loops mapped alike.
+
+    >>> from splinevis.nurbs.exact import saddle
+    >>> s, _ = _flip_v(saddle(), None)
+    >>> bool(np.allclose(s.normal([0.3], [0.4]), -saddle().normal([0.3], [0.6]), atol=1e-15))
+    True
+    """
+    V = surface.knots[1]
+    a, b = surface.domain[1]
+    flipped = NurbsSurface(surface.degree, (surface.knots[0], (a + b) - V[::-1]), surface.control_points[:, ::-1],
+                           None if surface.weights is None else surface.weights[:, ::-1], name=surface.name)
+    if loops is None:
+        return flipped, None
+    mirror = np.array([1.0, -1.0])
+    new = [[TrimCurve(c.degree, c.knots, c.control_points * mirror + [0.0, a + b], c.weights) for c in loop]
+           for loop in loops]
+    return flipped, new
 
 
 def bspline_surface(surf, name: str = "") -> NurbsSurface:
