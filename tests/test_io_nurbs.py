@@ -425,3 +425,25 @@ def test_step_reversed_faces_are_flipped_so_every_box_normal_points_out(tmp_path
         from splinevis.nurbs.trim import inside, trim_pieces
 
         assert inside(trim_pieces([loops]), 0, u, v).all()  # the mirrored loops still hold the face's inside
+
+
+def test_3dm_face_orientation_is_kept(tmp_path):
+    # a Rhino box's faces point out; Brep.Flip() marks every face reversed (the outside is now inside):
+    # read back, S_u x S_v follows the face, not the underlying surface
+    import rhino3dm
+
+    for flip, sign in ((False, 1.0), (True, -1.0)):
+        box = rhino3dm.Brep.CreateFromBox(rhino3dm.Box(rhino3dm.BoundingBox(0, 0, 0, 2, 1, 1)))
+        if flip:
+            box.Flip()
+            assert all(f.OrientationIsReversed for f in box.Faces)
+        f = rhino3dm.File3dm()
+        f.Objects.AddBrep(box)
+        path = tmp_path / f"box{int(flip)}.3dm"
+        f.Write(str(path), 7)
+        model = read_nurbs(path)
+        assert len(model) == 6
+        for s in model.surfaces:
+            (u0, u1), (v0, v1) = s.domain
+            u, v = np.array([(u0 + u1) / 2]), np.array([(v0 + v1) / 3])
+            assert sign * np.dot(s.normal(u, v)[0], s.evaluate(u, v)[0] - [1.0, 0.5, 0.5]) > 0, (flip, s.name)

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
-from .nurbs_common import build_model, checked
+from .nurbs_common import build_model, checked, flip_v
 
 __all__ = ["read_3dm"]
 
@@ -75,6 +75,8 @@ def read_3dm(path) -> NurbsModel:
                     if loops is None:
                         skipped[_CURVED_TRIMMED] = skipped.get(_CURVED_TRIMMED, 0) + 1
                         continue
+                if face.OrientationIsReversed:  # the face's outside is the surface's back
+                    surf, loops = flip_v(surf, loops)
                 surfaces.append(surf)
                 trims.append(loops)
         elif isinstance(g, rhino3dm.Surface):

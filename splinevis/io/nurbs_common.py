@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import warnings
 
-from ..nurbs import NurbsModel
+import numpy as np
 
-__all__ = ["build_model", "checked"]
+from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
+
+__all__ = ["build_model", "checked", "flip_v"]
 
 
 def checked(path, entity: str, make):
@@ -15,7 +17,6 @@ def checked(path, entity: str, make):
 
     Examples
     --------
-    >>> from splinevis.nurbs import TrimCurve
     >>> checked("a.igs", "entity 128 #3", lambda: TrimCurve(1, [0, 0, 1, 1], [[0, 0], [1, 1]], [1, 0]))
     Traceback (most recent call last):
     ValueError: a.igs: entity 128 #3: trim curve weights must be 2 positive numbers, got [1, 0].
@@ -45,7 +46,6 @@ def build_model(path, kind: str, surfaces, trims, skipped: dict, contents: dict 
 
     Examples
     --------
-    >>> from splinevis.nurbs import NurbsSurface
     >>> s = NurbsSurface.bilinear([[0, 0, 0], [1, 0, 0]], [[0, 1, 0], [1, 1, 0]], name="quad")
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as w:
@@ -67,3 +67,24 @@ def build_model(path, kind: str, surfaces, trims, skipped: dict, contents: dict 
     if skipped:
         warnings.warn(f"{path}: skipped unsupported entities: {listing}", UserWarning, stacklevel=3)
     return NurbsModel(surfaces, trims, source=source, skipped=skipped)
+
+
+def flip_v(surface: NurbsSurface, loops):
+    """The same surface with v running backwards (so S_u x S_v flips), and its trim loops mapped alike: how a
+    reversed face (its outside the surface's back) is brought to the convention normal = outside.
+
+    >>> from splinevis.nurbs.exact import saddle
+    >>> s, _ = flip_v(saddle(), None)
+    >>> bool(np.allclose(s.normal([0.3], [0.4]), -saddle().normal([0.3], [0.6]), atol=1e-15))
+    True
+    """
+    V = surface.knots[1]
+    a, b = surface.domain[1]
+    flipped = NurbsSurface(surface.degree, (surface.knots[0], (a + b) - V[::-1]), surface.control_points[:, ::-1],
+                           None if surface.weights is None else surface.weights[:, ::-1], name=surface.name)
+    if loops is None:
+        return flipped, None
+    mirror = np.array([1.0, -1.0])
+    new = [[TrimCurve(c.degree, c.knots, c.control_points * mirror + [0.0, a + b], c.weights) for c in loop]
+           for loop in loops]
+    return flipped, new

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
-from .nurbs_common import build_model, checked
+from .nurbs_common import build_model, checked, flip_v
 
 __all__ = ["read_step", "ocp_available", "shape_to_model", "shape_faces", "bspline_surface", "OCP_HINT"]
 
@@ -155,30 +155,10 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
         surface = checked(path, name, lambda: bspline_surface(surf, name))
         loops = [_loop(wire, face, path, name) for wire in _wires(face)] or None
         if face.Orientation() == TopAbs_REVERSED:  # the face's outside is the surface's back: mirror v
-            surface, loops = _flip_v(surface, loops)
+            surface, loops = flip_v(surface, loops)
         surfaces.append(surface)
         trims.append(loops)
     return surfaces, trims
-
-
-def _flip_v(surface: NurbsSurface, loops):
-    """The same surface with v running backwards (so S_u x S_v flips), and its trim loops mapped alike.
-
-    >>> from splinevis.nurbs.exact import saddle
-    >>> s, _ = _flip_v(saddle(), None)
-    >>> bool(np.allclose(s.normal([0.3], [0.4]), -saddle().normal([0.3], [0.6]), atol=1e-15))
-    True
-    """
-    V = surface.knots[1]
-    a, b = surface.domain[1]
-    flipped = NurbsSurface(surface.degree, (surface.knots[0], (a + b) - V[::-1]), surface.control_points[:, ::-1],
-                           None if surface.weights is None else surface.weights[:, ::-1], name=surface.name)
-    if loops is None:
-        return flipped, None
-    mirror = np.array([1.0, -1.0])
-    new = [[TrimCurve(c.degree, c.knots, c.control_points * mirror + [0.0, a + b], c.weights) for c in loop]
-           for loop in loops]
-    return flipped, new
 
 
 def bspline_surface(surf, name: str = "") -> NurbsSurface:
