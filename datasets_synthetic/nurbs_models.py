@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hood", "patch_tiling", "degree_patch"]
+__all__ = ["hood", "patch_tiling", "degree_patch", "vase"]
 
 
 def hood(n: int = 8, seed: int = 3):
@@ -66,3 +66,48 @@ def degree_patch(p: int, seed: int = 0):
     X, Y = np.meshgrid(g, g, indexing="ij")
     Z = 0.25 * np.sin(1.7 * X + 0.3) * np.cos(1.3 * Y) + 0.05 * np.random.default_rng(seed).normal(size=X.shape)
     return NurbsSurface((p, p), (knots, knots), np.stack([X, Y, Z], axis=-1), name=f"degree{p}")
+
+
+def vase(profile=((0.0, 0.0), (1.0, 0.0), (1.3, 0.6), (0.9, 1.2), (0.6, 1.6), (0.7, 2.1), (0.9, 2.4), (0.85, 2.6)),
+         segments: int = 8):
+    """A vase of ``4 * segments`` bicubic Bezier patches, built the way the Newell teapot's body is: a profile of
+    cubic Bezier segments (a Catmull-Rom spline through the ``profile`` points (radius, height), resampled to
+    ``segments`` segments) revolved in four quarter turns, each quarter circle the cubic Bezier approximation
+    with handles ``k = 4/3 (sqrt(2) - 1)`` (radial error 2.7e-4 of the radius) [Farin2002, ch. 13].
+
+    >>> m = vase()
+    >>> len(m), m.surfaces[0].degree, m.surfaces[0].shape
+    (32, (3, 3), (4, 4))
+    """
+    from splinevis.nurbs.model import NurbsModel
+    from splinevis.nurbs.surface import NurbsSurface
+
+    pts = np.asarray(profile, dtype=np.float64)
+    # Catmull-Rom through the points, then resampled: Bezier control points of each segment
+    ext = np.vstack([2 * pts[0] - pts[1], pts, 2 * pts[-1] - pts[-2]])
+    t = np.linspace(0.0, len(pts) - 1.0, segments + 1)
+
+    def cr(s, d=0):
+        i = np.clip(np.floor(s).astype(int), 0, len(pts) - 2)
+        u = (s - i)[:, None]
+        p0, p1, p2, p3 = ext[i], ext[i + 1], ext[i + 2], ext[i + 3]
+        if d == 0:
+            return 0.5 * (2 * p1 + (-p0 + p2) * u + (2 * p0 - 5 * p1 + 4 * p2 - p3) * u**2 + (-p0 + 3 * p1 - 3 * p2 + p3) * u**3)
+        return 0.5 * ((-p0 + p2) + 2 * (2 * p0 - 5 * p1 + 4 * p2 - p3) * u + 3 * (-p0 + 3 * p1 - 3 * p2 + p3) * u**2)
+
+    a, b = cr(t[:-1]), cr(t[1:])
+    h = (t[1] - t[0]) / 3.0
+    prof = np.stack([a, a + h * cr(t[:-1], 1), b - h * cr(t[1:], 1), b], axis=1)  # (segments, 4, (r, z))
+    k = 4.0 / 3.0 * (np.sqrt(2.0) - 1.0)
+    knots = [0.0] * 4 + [1.0] * 4
+    patches = []
+    for q in range(4):
+        c0, s0 = np.cos(q * np.pi / 2), np.sin(q * np.pi / 2)
+        e0, e1 = np.array([c0, s0]), np.array([-s0, c0])  # start direction and its quarter turn
+        arc = np.stack([e0, e0 + k * e1, e1 + k * e0, e1])  # the unit quarter circle's cubic Bezier net
+        for sgm in range(segments):
+            P = np.empty((4, 4, 3))
+            P[..., :2] = arc[:, None, :] * prof[sgm][None, :, 0, None]
+            P[..., 2] = prof[sgm][None, :, 1]
+            patches.append(NurbsSurface((3, 3), (knots, knots), P, name=f"vase q{q} s{sgm}"))
+    return NurbsModel(patches, source=f"vase, {4 * segments} bicubic Bezier patches")

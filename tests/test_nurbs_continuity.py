@@ -34,3 +34,17 @@ def test_unrelated_patches_have_no_seam_and_lines_carry_classes():
     assert find_seams([A, moved]) == []
     lines = seam_lines(find_seams(joined_pair("G1")) + find_seams(joined_pair("G2")))
     assert sorted(set(lines.point_data["level"].tolist())) == [0, 1]
+
+
+def test_vase_seams_are_g2_around_and_g1_along_the_profile():
+    # the quarter circles meet with equal tangents and (by symmetry) equal end curvatures: G2, 4 x 8 seams;
+    # the Catmull-Rom profile is C1 with curvature jumps: G1, 4 x 7 seams; the collapsed bottom row is a point
+    from datasets_synthetic.nurbs_models import vase
+
+    seams = find_seams(vase().surfaces)
+    levels = {}
+    for s in seams:
+        levels.setdefault((s.side_a[0], s.level), 0)
+        levels[(s.side_a[0], s.level)] += 1
+    assert len(seams) == 60
+    assert levels == {("u", "G2"): 32, ("v", "G1"): 28}

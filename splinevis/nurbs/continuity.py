@@ -73,8 +73,7 @@ def _cross_curvature(s: NurbsSurface, u, v, along_u: bool, n_ref):
     """Normal curvature across the boundary, the normal oriented like ``n_ref``; and the oriented normal."""
     SKL = s.derivatives(u, v, 2)
     Su, Sv = SKL[:, 1, 0], SKL[:, 0, 1]
-    n = np.cross(Su, Sv)
-    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    n = s.normal(u, v)  # unit; the limit normal at a pole
     sign = np.where(np.einsum("ij,ij->i", n, n_ref) < 0, -1.0, 1.0)
     n *= sign[:, None]
     T = Sv if along_u else Su  # the boundary's tangent: a u = const side runs along v
@@ -111,7 +110,10 @@ def find_seams(surfaces, samples: int = 33, match: float = 1e-6, tol_gap: float 
     for k, s in enumerate(surfaces):
         for side in _SIDES:
             u, v = _boundary_params(s, side, t)
-            edges.append((k, side, u, v, s.evaluate(u, v)))
+            pts = s.evaluate(u, v)
+            if np.ptp(pts, axis=0).max() <= match * size:
+                continue  # a collapsed boundary (a pole): a point, not a seam
+            edges.append((k, side, u, v, pts))
     seams = []
     for i in range(len(edges)):
         for j in range(i + 1, len(edges)):

@@ -10,7 +10,9 @@ depends on.
   OpenCASCADE's tessellation at deflections 1e-2..1e-5 of the model size when ``OCP`` is installed, and the
   per-fragment program; each with its median frame time, measured in the same run.
 * **Frame time against patch count** (1, 32, 1 024 and, unless quick, 10 000 bicubic tiles covering the same
-  square) and **against degree** (1..7, one patch), with the texture memory of each program.
+  square; and a 32-patch vase built as the Newell teapot's body is, cubic profile segments revolved in cubic
+  quarter circles, for the teapot's row: the teapot's own data is not shipped) and **against degree** (1..7,
+  one patch), with the texture memory of each program.
 
 The markdown says, for this machine, at which accuracy the per-fragment program beats the finest mesh that
 reaches it (or that none does).
@@ -181,18 +183,19 @@ def _texture_bytes(model) -> tuple:
 
 def scaling_rows(*, counts, degrees, window, repeats, progress=True):
     """Frame time and texture memory against the number of patches and against the degree."""
-    from datasets_synthetic.nurbs_models import degree_patch, patch_tiling
+    from datasets_synthetic.nurbs_models import degree_patch, patch_tiling, vase
 
     camera = [(1.0, -1.8, 2.2), (1.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
     out = []
-    jobs = [("patches", c) for c in counts] + [("degree", p) for p in degrees]
+    jobs = [("patches", c) for c in counts] + [("vase", 32)] + [("degree", p) for p in degrees]
     for kind, k in progress_bar(jobs, "nurbs: scaling", enabled=progress):
-        model = patch_tiling(k) if kind == "patches" else degree_patch(k)
+        model = {"patches": patch_tiling, "degree": degree_patch, "vase": lambda n: vase()}[kind](k)
+        view = [(3.2, -3.2, 3.0), (0.0, 0.0, 1.2), (0.0, 0.0, 1.0)] if kind == "vase" else camera
         t0 = time.perf_counter()
-        pl = _scene(window, camera)
+        pl = _scene(window, view)
         pl.add_nurbs(model, lights=1)
         build = time.perf_counter() - t0
-        _, _, t = _finish(pl, camera, repeats)
+        _, _, t = _finish(pl, view, repeats)
         payload, allocated = _texture_bytes(model)
         out.append({"kind": kind, "value": k, "build_s": build, **t, "payload_bytes": payload, "texture_bytes": allocated})
     return out
