@@ -10,9 +10,7 @@ from scipy import ndimage
 
 import splinevis
 from datasets_synthetic.nurbs_joins import joined_pair
-from splinevis.gl.camera import pixel_rays
 from splinevis.nurbs import NurbsModel
-from splinevis.programs import get
 
 pytestmark = pytest.mark.gl
 
@@ -36,17 +34,10 @@ def _render(model):
 
 
 def _reference(model, matrix):
-    from splinevis.effects import line_frame
+    from splinevis.studies.nurbs import zebra_reference
 
-    o, d = pixel_rays(matrix, *WINDOW)
-    hits = get("nurbs").raycast(model, o, d, 0.0)
-    rd = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    n = hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
-    n = np.where((np.einsum("...i,...i", n, rd) > 0)[..., None], -n, n)
-    r = rd - 2 * np.einsum("...i,...i", rd, n)[..., None] * n
-    b, c = (np.asarray(v) for v in line_frame(AXIS))
-    x = np.arctan2(r @ b, r @ c) / np.pi * STRIPES
-    return (x - np.floor(x)) >= 0.5, hits.hit
+    bright, hit, _ = zebra_reference(model, matrix, WINDOW, stripes=STRIPES, axis=AXIS)
+    return bright, hit
 
 
 def _seam_frame(matrix):
