@@ -139,6 +139,8 @@ class Plotter(pv.Plotter):
 
         st = _style_from(style, style_options)
         program = program_for(model)
+        if not isinstance(model, program.model_type):  # a type the program converts (SplineProgram.converts)
+            model = program.model_from(model)
         built = program.make(model, st, newton_iterations=newton_iterations, **(program_options or {}))
         if program.kind in ("passes", "mesh"):  # the program made an ordinary dataset: a mesh with the effects
             from .gl.mesh_effects import add_mesh_with_effects

@@ -143,5 +143,8 @@ def program_for(model) -> SplineProgram:
         for program in reversed(list(_programs.values())):  # later registrations win on the same type
             if program.model_type is cls:
                 return program
+    for program in reversed(list(_programs.values())):  # a type a program's model_from converts
+        if program.converts and isinstance(model, program.converts):
+            return program
     known = ", ".join(f"{p.model_type.__name__} ({p.name})" for p in _programs.values())
     raise TypeError(f"no spline program draws a {type(model).__name__}; registered programs draw: {known}.")

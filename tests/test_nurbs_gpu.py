@@ -98,3 +98,10 @@ def test_curvature_per_pixel_matches_the_exact_torus(kind):
     assert both.sum() > 3000 and ok.sum() > 1000
     err = np.abs((got if kind == "gaussian" else np.abs(got)) - (want if kind == "gaussian" else np.abs(want)))[ok]
     assert err.max() <= 1.5 / 255 / 0.77 * scale
+
+
+def test_a_single_surface_is_drawn_as_a_one_patch_model():
+    assert programs.program_for(torus()) is PROGRAM  # NurbsSurface: converted by the program's model_from
+    actor, img, depth, _ = _render(torus(), [(4.0, -5.0, 3.0), (0, 0, 0), (0, 0, 1)], lights=1)
+    assert isinstance(actor.model, NurbsModel) and actor.model.names == ("torus",)
+    assert (depth < 1.0).mean() > 0.2

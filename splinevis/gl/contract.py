@@ -169,6 +169,9 @@ class SplineProgram:
     model_from : callable, optional
         ``model_from(data, *args, **kwargs)`` builds a model from user data (arrays, files, grids); what
         the Plotter's convenience methods call.
+    converts : tuple of types
+        Other model types ``model_from`` turns into a ``model_type`` (``Plotter.add_spline`` converts them,
+        e.g. one NURBS surface into a one-patch model).
     on_add : callable, optional
         ``on_add(actor, plotter, **options)`` after the actor is in the scene (e.g. frustum culling).
     root_methods : tuple of str
@@ -207,6 +210,7 @@ class SplineProgram:
     newton_iterations: int = 8
     options: tuple = ()
     description: str = ""
+    converts: tuple = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -217,6 +221,8 @@ class SplineProgram:
             raise TypeError(f"SplineProgram {self.name!r}: model_type must be a class, got {self.model_type!r}.")
         if not callable(self.build):
             raise TypeError(f"SplineProgram {self.name!r}: build must be callable.")
+        if self.converts and self.model_from is None:
+            raise ValueError(f"SplineProgram {self.name!r}: converts needs a model_from that does the conversion.")
         if self.kind == "raycast" and (self.reference is None or self.depth_bound is None):
             raise ValueError(f"SplineProgram {self.name!r}: a raycast program needs its float64 twin "
                              "(reference) and its derived depth_bound; the tests compare the GPU against them.")

@@ -149,4 +149,5 @@ def _build(model, style, *, newton_iterations, subdivisions=8):
 PROGRAM = SplineProgram(
     name="nurbs", kind="surface", model_type=NurbsModel, build=_build, reference=reference, depth_bound=depth_bound,
     hard_cases=_hard_cases, model_from=model_from, root_methods=("newton",), newton_iterations=12,
-    options=("subdivisions",), description="NURBS patches evaluated per fragment, Newton on the pixel ray [Kanai2007]")
+    options=("subdivisions",), description="NURBS patches evaluated per fragment, Newton on the pixel ray [Kanai2007]",
+    converts=(NurbsSurface,))
