@@ -113,12 +113,12 @@ def test_the_certified_shell_push_is_at_least_the_densely_sampled_chord_deviatio
     # by a sample); and it stays within 10x of it (not uselessly loose)
     from datasets_synthetic.nurbs_models import degree_patch, hood, vase
     from splinevis.nurbs.hard_cases import crease, degree7
-    from splinevis.nurbs.raycast import _breaks, _chord_deviation, certified_deviation
+    from splinevis.nurbs.raycast import _chord_deviation, certified_deviation
+    from splinevis.nurbs.tessellate import span_grid
 
     models = [sphere(), torus(), crease(), degree7(), hood(), degree_patch(5)] + list(vase().surfaces[:8])
     for s in models:
-        (p, q), (U, V) = s.degree, s.knots
-        us, vs = _breaks(U, p, s.shape[0], 8), _breaks(V, q, s.shape[1], 8)
+        us, vs = span_grid(s, 8)
         bound, dense = certified_deviation(s, us, vs), _chord_deviation(s, us, vs, 1.0, k=32)
         assert (bound >= dense).all(), s.name
         assert (bound <= 10 * dense + 1e-9 * np.abs(s.control_points).max()).all(), s.name

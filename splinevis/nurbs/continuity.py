@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .surface import NurbsSurface, fundamental_curvature
+from .surface import NurbsSurface
 
 __all__ = ["Seam", "find_seams", "seam_lines", "CLASS_COLORS"]
 

@@ -26,7 +26,7 @@ import numpy as np
 from .basis import find_span
 from .surface import NurbsSurface
 
-__all__ = ["insert_knot", "refine_knots", "elevate_degree", "bezier_patches"]
+__all__ = ["bezier_segments", "insert_knot", "refine_knots", "elevate_degree", "bezier_patches"]
 
 
 def _axis(direction) -> int:
@@ -217,6 +217,29 @@ def elevate_degree(surface: NurbsSurface, direction, times: int = 1) -> NurbsSur
     return _rebuild(surface, a, Q, tail, p + times, U)
 
 
+def _curve_decompose(p, U, Pw, where):
+    """Clamp the curve and raise every interior knot to multiplicity p [PieglTiller1997, A5.6]: ``(U, Qw, spans)``
+    with ``spans`` the ``(first control point, (t0, t1))`` of each Bezier segment ``Qw[first:first + p + 1]``."""
+    U, Q = _curve_clamp(p, U, Pw, where)
+    vals, mult = np.unique(U[p + 1:-(p + 1)], return_counts=True)
+    U, Q = _curve_refine(p, U, Q, np.repeat(vals, np.maximum(p - mult, 0)), where)
+    starts = [k for k in range(p, U.size - p - 1) if U[k] < U[k + 1]]
+    return U, Q, [(k - p, (float(U[k]), float(U[k + 1]))) for k in starts]
+
+
+def bezier_segments(degree: int, knots, Pw, where: str = "curve knots") -> list:
+    """The Bezier segments of a (rational) B-spline curve, clamped or not: a list of ``(p + 1, k)`` arrays of
+    its control points (rows, e.g. homogeneous ``(w x, w y, w)``), one per non-empty knot span of the domain.
+
+    >>> segs = bezier_segments(2, [0, 0, 0, 0.5, 1, 1, 1], np.array([[0.0], [1.0], [3.0], [4.0]]))
+    >>> [s.ravel().tolist() for s in segs]
+    [[0.0, 1.0, 2.0], [2.0, 3.0, 4.0]]
+    """
+    p = int(degree)
+    _, Q, spans = _curve_decompose(p, np.asarray(knots, dtype=np.float64), np.asarray(Pw, dtype=np.float64), where)
+    return [Q[first:first + p + 1] for first, _ in spans]
+
+
 def bezier_patches(surface: NurbsSurface) -> list:
     """The (rational) Bezier patches of the surface, one per non-empty knot rectangle, in order u-major:
     a list of ``(patch, ((u0, u1), (v0, v1)))``; each patch is a clamped single-span :class:`NurbsSurface`
@@ -233,12 +256,9 @@ def bezier_patches(surface: NurbsSurface) -> list:
         p, U = s.degree[a], s.knots[a]
         flat, tail = _net(s, a)
         where = "knots[0] (u)" if a == 0 else "knots[1] (v)"
-        U, Q = _curve_clamp(p, U, flat, where)
-        vals, mult = np.unique(U[p + 1:-(p + 1)], return_counts=True)
-        U, Q = _curve_refine(p, U, Q, np.repeat(vals, np.maximum(p - mult, 0)), where)
+        U, Q, spans = _curve_decompose(p, U, flat, where)
         s = _rebuild(s, a, Q, tail, p, U)
-        starts = [k for k in range(p, U.size - p - 1) if U[k] < U[k + 1]]
-        pieces.append([(k - p, (float(U[k]), float(U[k + 1]))) for k in starts])
+        pieces.append(spans)
     (p, q), W = s.degree, s.weights
     out = []
     for i0, (u0, u1) in pieces[0]:

@@ -19,6 +19,7 @@ from ..gl.contract import RayHits
 from ..gl.error_bounds import U32, depth_error, model_frame_matrix
 from .model import NurbsModel
 from .surface import NurbsSurface
+from .tessellate import span_grid
 
 __all__ = ["model_offset", "patch_facts", "tessellate", "newton_on_rays", "reference", "residual_tolerance",
            "depth_bound"]
@@ -80,12 +81,6 @@ def patch_facts(model) -> list:
     return out
 
 
-def _breaks(U, p, n, sub):
-    k = np.unique(U[p: n + 1])
-    t = np.linspace(0.0, 1.0, sub + 1)[:-1]
-    return np.append((k[:-1, None] + t * np.diff(k)[:, None]).ravel(), k[-1])
-
-
 def tessellate(model, subdivisions: int = 4, margin: float = 2.0, certified: bool = True):
     """The shell the GPU rasterizes: per patch, each non-empty knot span cut into ``subdivisions`` parts in u
     and v; every grid vertex carries its ``(u, v)`` and patch id.
@@ -109,9 +104,7 @@ def tessellate(model, subdivisions: int = 4, margin: float = 2.0, certified: boo
     P, T, UV, ID = [], [], [], []
     base = 0
     for k, s in enumerate(m.surfaces):
-        (p, q), (U, V) = s.degree, s.knots
-        nu, nv = s.shape
-        us, vs = _breaks(U, p, nu, subdivisions), _breaks(V, q, nv, subdivisions)
+        us, vs = span_grid(s, subdivisions)
         dev = certified_deviation(s, us, vs) if certified else _chord_deviation(s, us, vs, margin)
         hu, hv = np.diff(us), np.diff(vs)
         floor = 64 * U32 * facts[k]["magnitude"]

@@ -19,6 +19,8 @@ from math import comb
 
 import numpy as np
 
+from .operations import bezier_segments
+
 __all__ = ["TrimPieces", "trim_pieces", "inside", "MAX_TRIM_DEGREE", "PIECE_FLOATS"]
 
 #: Highest trim-curve degree the per-fragment test handles.
@@ -59,26 +61,10 @@ class TrimPieces:
 
 
 def _bezier_segments(curve):
-    """Homogeneous Bezier segments (k, p+1, 3) of a TrimCurve by knot insertion."""
-    p, U = curve.degree, list(curve.knots)
+    """Homogeneous Bezier segments (k, p+1, 3) of a TrimCurve (:func:`splinevis.nurbs.operations.bezier_segments`)."""
     w = np.ones(len(curve.control_points)) if curve.weights is None else curve.weights
     Pw = np.column_stack([curve.control_points * w[:, None], w])
-    lo, hi = U[p], U[len(Pw)]
-    for x in sorted(set(k for k in U if lo <= k <= hi)):  # the domain's ends too (unclamped knots)
-        while U.count(x) < p:  # A5.1 one insertion at a time
-            # the span holding x; the domain's right end is inserted from the left (its span to the right may
-            # have no control points of its own)
-            k = int(np.searchsorted(U, x, side="left" if x == hi else "right")) - 1
-            Q = np.empty((len(Pw) + 1, 3))
-            Q[: k - p + 1] = Pw[: k - p + 1]
-            Q[k + 1:] = Pw[k:]
-            for i in range(k - p + 1, k + 1):
-                a = (x - U[i]) / (U[i + p] - U[i])
-                Q[i] = a * Pw[i] + (1 - a) * Pw[i - 1]
-            Pw, U = Q, U[: k + 1] + [x] + U[k + 1:]
-    first = int(np.searchsorted(U, lo, side="right")) - 1 - p  # the segment starting at the domain's start
-    nseg = len(set(k for k in U if lo <= k <= hi)) - 1
-    return np.asarray([Pw[first + s * p: first + s * p + p + 1] for s in range(nseg)])
+    return np.asarray(bezier_segments(curve.degree, curve.knots, Pw, "trim curve knots"))
 
 
 def _split(seg, t):
