@@ -30,7 +30,7 @@ WITHOUT_EXAMPLES = {
     # the full volume study (minutes even with quick=True)
     "splinevis.studies.volume": {"run_volume_study"},
     # the NURBS study and its parts: dozens of 320x240 to 640x480 scenes, the float64 twin per pixel
-    "splinevis.studies.nurbs": {"run_nurbs_study", "zebra_reference"},
+    "splinevis.studies.nurbs": {"run_nurbs_study"},
     # the showcase's NURBS figure: four 520x390 scenes
     "splinevis.studies.nurbs_demo": {"nurbs_figure"},
     # the sweep: ~24 windows of 200x150 (its window is fixed) even with quick=True, cubic=False, n=8,

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import splinevis
-from splinevis.effects import line_frame
+from splinevis.analysis.zebra import zebra_reference
 from splinevis.gl.camera import pixel_rays
 from splinevis.io import VolumeGrid
 from splinevis.programs import program_for
@@ -71,15 +71,9 @@ def sphere():
 def test_reflection_lines_about_any_axis_match_the_twin(sphere, axis):
     stripes = 6
     img, matrix = _render(sphere, reflection_lines=stripes, reflection_axis=axis)
-    hits, rd = _twin(sphere, matrix)
-    n = hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
-    n = np.where((np.einsum("...i,...i", n, rd) > 0)[..., None], -n, n)
-    r = rd - 2 * np.einsum("...i,...i", rd, n)[..., None] * n
-    b, c = (np.asarray(v) for v in line_frame(axis))
-    phi = np.arctan2(r @ b, r @ c) / np.pi
-    bright, dist = _stripe(phi * stripes)
+    bright, hit, dist = zebra_reference(sphere, matrix, WINDOW, stripes, axis)
     # the stripe phase moves by (2 stripes / pi) * |dr| with |dr| <= 2 |dn|: margin in phase units
-    ok = hits.hit & (dist > 4 * stripes / np.pi * ANGLE_MARGIN)
+    ok = hit & (dist > 4 * stripes / np.pi * ANGLE_MARGIN)
     assert ok.sum() > 2000 and 0.3 < bright[ok].mean() < 0.7  # both colours, a good part of the picture
     got_bright = img[..., 0] > 0.5
     assert (got_bright[ok] == bright[ok]).mean() >= 0.998

@@ -34,9 +34,9 @@ def _render(model):
 
 
 def _reference(model, matrix):
-    from splinevis.studies.nurbs import zebra_reference
+    from splinevis.analysis.zebra import zebra_reference
 
-    bright, hit, _ = zebra_reference(model, matrix, WINDOW, stripes=STRIPES, axis=AXIS)
+    bright, hit, _ = zebra_reference(model, matrix, WINDOW, STRIPES, AXIS)
     return bright, hit
 
 

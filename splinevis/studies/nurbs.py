@@ -26,9 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.zebra import zebra_reference
 from .report import clean, log, md_table, progress_bar, pyplot, save_figure, timed, write_json
 
-__all__ = ["run_nurbs_study", "zebra_reference", "zebra_error", "PARETO_CAMERA"]
+__all__ = ["run_nurbs_study", "zebra_error", "PARETO_CAMERA"]
 
 PARETO_CAMERA = [(1.0, -1.6, 1.5), (1.0, 0.5, 0.1), (0.0, 0.0, 1.0)]
 STRIPES = 10
@@ -45,29 +46,9 @@ def _program():
     return get("nurbs")
 
 
-def zebra_reference(model, matrix, window, stripes=STRIPES, axis=AXIS):
-    """The exact stripe colour per pixel (True bright) from the float64 twin, the hit mask and each pixel's
-    distance to the nearest stripe edge in stripe widths.
-    """
-    from ..effects import line_frame
-    from ..gl.camera import pixel_rays
-
-    w, h = window
-    o, d = pixel_rays(matrix, w, h)
-    hits = _program().raycast(model, o, d, 0.0)
-    rd = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    n = hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
-    n = np.where((np.einsum("...i,...i", n, rd) > 0)[..., None], -n, n)
-    r = rd - 2 * np.einsum("...i,...i", rd, n)[..., None] * n
-    b, c = (np.asarray(v) for v in line_frame(axis))
-    x = np.arctan2(r @ b, r @ c) / np.pi * stripes
-    f = x - np.floor(x)
-    return f >= 0.5, hits.hit, np.minimum(np.abs(f - 0.5), np.minimum(f, 1 - f))
-
-
 def zebra_error(image, reference) -> dict:
     """Share of wrongly coloured surface pixels (in %) and mean stripe displacement (pixels) of a rendered
-    zebra ``image`` (H, W, 3 floats in [0, 1]) against :func:`zebra_reference`.
+    zebra ``image`` (H, W, 3 floats in [0, 1]) against :func:`splinevis.analysis.zebra.zebra_reference`.
 
     >>> bright = np.array([[True, False], [True, True]])
     >>> ref = (bright, np.ones((2, 2), bool), np.full((2, 2), 0.25))
@@ -122,7 +103,7 @@ def pareto_rows(model, *, window, densities, deflections, repeats, progress=True
     from .nurbs_occ import occ_available, occ_tessellate
 
     img, matrix, t_spline = _render_spline(model, window, PARETO_CAMERA, repeats)
-    ref = zebra_reference(model, matrix, window)
+    ref = zebra_reference(model, matrix, window, STRIPES, AXIS)
     rows = [{"method": "per fragment", "triangles": None, "chord_deviation": 0.0, **t_spline, **zebra_error(img, ref)}]
     size = float(np.linalg.norm(np.subtract(*np.asarray(model.bounds()).reshape(3, 2).T)))
     jobs = [("mesh", n) for n in densities] + ([("occ", d) for d in deflections] if occ_available() else [])
