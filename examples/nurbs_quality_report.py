@@ -46,10 +46,7 @@ panels = {
     "Gaussian curvature": {"output": "curvature", "curvature": "gaussian"},
     "draft angle (pull (0, 0.8, 0.6), 3 deg)": {"output": "draft", "pull_direction": (0, 0.8, 0.6), "draft_angle": 3.0},
 }
-u = np.linspace(0, 1, 41)
-K = np.concatenate([s.curvature(*(a.ravel() for a in np.meshgrid(
-    s.domain[0][0] + u * (s.domain[0][1] - s.domain[0][0]), s.domain[1][0] + u * (s.domain[1][1] - s.domain[1][0]))))["K"]
-    for s in model.surfaces])
+K = model.curvature_samples(41)["K"]
 panels["Gaussian curvature"]["curvature_scale"] = float(np.nanmax(np.abs(K)))
 images = {}
 for title, style in panels.items():

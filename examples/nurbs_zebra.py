@@ -26,13 +26,7 @@ out = sys.argv[2] if len(sys.argv) > 2 else "nurbs_zebra.png"
 print(f"read {model.source or 'model'}: {len(model)} patches")
 
 # the true curvature range on the surface (float64), for the legend
-u = np.linspace(0, 1, 101)
-H = []
-for s in model.surfaces:
-    (u0, u1), (v0, v1) = s.domain
-    U, V = np.meshgrid(u0 + u * (u1 - u0), v0 + u * (v1 - v0))
-    H.append(s.curvature(U.ravel(), V.ravel())["H"])
-H = np.concatenate(H)
+H = model.curvature_samples(101)["H"]
 scale = float(np.nanmax(np.abs(H)))
 
 x0, x1, y0, y1, z0, z1 = model.bounds()

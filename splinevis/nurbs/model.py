@@ -130,6 +130,23 @@ class NurbsModel:
         """
         return tuple(s.name for s in self.surfaces)
 
+    def curvature_samples(self, n: int = 41) -> dict:
+        """Curvatures (``K``, ``H``, ``k1``, ``k2``, as :meth:`NurbsSurface.curvature`) at an ``n x n`` grid of
+        every patch's domain, concatenated: the surface's true range for a colour legend, in float64.
+
+        >>> from splinevis.nurbs.exact import sphere
+        >>> c = NurbsModel([sphere(2.0)]).curvature_samples(11)
+        >>> c["K"].size, round(float(np.nanmedian(c["K"])), 12)
+        (121, 0.25)
+        """
+        t = np.linspace(0.0, 1.0, n)
+        parts = []
+        for s in self.surfaces:
+            (u0, u1), (v0, v1) = s.domain
+            U, V = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
+            parts.append(s.curvature(U.ravel(), V.ravel()))
+        return {key: np.concatenate([c[key] for c in parts]) for key in parts[0]}
+
     def bounds(self) -> tuple:
         """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of all control points (the convex-hull box).
 

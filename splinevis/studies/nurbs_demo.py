@@ -32,10 +32,7 @@ def nurbs_figure(path, window=(520, 390), mesh_density=2):
 
     model = _model()
     mesh = tessellate(model, mesh_density)
-    u = np.linspace(0.0, 1.0, 41)
-    H = np.concatenate([s.curvature(*(a.ravel() for a in np.meshgrid(
-        s.domain[0][0] + u * np.ptp(s.domain[0]), s.domain[1][0] + u * np.ptp(s.domain[1]))))["H"] for s in model.surfaces])
-    scale = float(np.abs(H).max())
+    scale = float(np.abs(model.curvature_samples(41)["H"]).max())
     zebra = {"reflection_lines": 12, "reflection_axis": (1.0, 0.0, 0.0)}
 
     def shot(draw):
