@@ -132,7 +132,8 @@ class NurbsModel:
 
     def curvature_samples(self, n: int = 41) -> dict:
         """Curvatures (``K``, ``H``, ``k1``, ``k2``, as :meth:`NurbsSurface.curvature`) at an ``n x n`` grid of
-        every patch's domain, concatenated: the surface's true range for a colour legend, in float64.
+        every patch's domain, concatenated: the surface's true range for a colour legend, in float64. Samples
+        where a patch's parametrization degenerates (poles) are NaN (see :meth:`NurbsSurface.curvature`).
 
         >>> from splinevis.nurbs.exact import sphere
         >>> c = NurbsModel([sphere(2.0)]).curvature_samples(11)

@@ -196,7 +196,8 @@ class NurbsSurface:
         """Gaussian ``K``, mean ``H`` and principal curvatures ``k1 >= k2`` with respect to :meth:`normal`.
 
         ``K = (LN - M^2) / (EG - F^2)``, ``H = (EN - 2FM + GL) / (2 (EG - F^2))``, ``k = H +- sqrt(H^2 - K)``
-        [DoCarmo1976, sec. 3-3]. Returns a dict of ``(len(u),)`` arrays ``K, H, k1, k2``.
+        [DoCarmo1976, sec. 3-3]. Returns a dict of ``(len(u),)`` arrays ``K, H, k1, k2``; NaN where the
+        parametrization degenerates (``EG - F^2`` at rounding level: poles, collapsed rows).
 
         Examples
         --------
@@ -267,6 +268,12 @@ def fundamental_curvature(SKL: np.ndarray) -> dict:
     E, F, G = (np.einsum("ij,ij->i", a, b) for a, b in ((Su, Su), (Su, Sv), (Sv, Sv)))
     L, M, N = (np.einsum("ij,ij->i", a, n) for a in (Suu, Suv, Svv))
     det = E * G - F * F
+    # where the parametrization degenerates (a pole, a collapsed row: S_u x S_v = 0 up to rounding) the
+    # formulas are 0/0; the curvature there is a limit they cannot give: NaN, not a rounding-sized quotient
+    # (a collapsed row leaves |S_u| at rounding level, ~1e-16 |S_v|: a ratio no regular point comes near)
+    eps = np.finfo(float).eps
+    regular = (det > 64.0 * eps * E * G) & (np.minimum(E, G) > (1e4 * eps) ** 2 * np.maximum(E, G))
+    det = np.where(regular, det, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         K = (L * N - M * M) / det
         H = (E * N - 2 * F * M + G * L) / (2 * det)

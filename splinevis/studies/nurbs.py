@@ -10,9 +10,8 @@ depends on.
   OpenCASCADE's tessellation at deflections 1e-2..1e-5 of the model size when ``OCP`` is installed, and the
   per-fragment program; each with its median frame time, measured in the same run.
 * **Frame time against patch count** (1, 32, 1 024 and, unless quick, 10 000 bicubic tiles covering the same
-  square; and a 32-patch vase built as the Newell teapot's body is, cubic profile segments revolved in cubic
-  quarter circles, for the teapot's row: the teapot's own data is not shipped) and **against degree** (1..7,
-  one patch), with the texture memory of each program.
+  square; and the Newell teapot's 32 patches [Crow1987]) and **against degree** (1..7, one patch), with the
+  texture memory of each program.
 
 The markdown says, for this machine, at which accuracy the per-fragment program beats the finest mesh that
 reaches it (or that none does).
@@ -38,6 +37,8 @@ AXIS = (0.0, 1.0, 0.0)
 #: through the pixel centre against the fragment's sample; pixels whose exact phase lies within this many
 #: stripe widths of an edge are not counted (both colours are right there).
 EDGE_MARGIN = 0.02
+#: The teapot's row: the whole pot, about as large on screen as the tiled square.
+TEAPOT_CAMERA = [(6.0, -7.5, 5.5), (0.2, 0.0, 1.4), (0.0, 0.0, 1.0)]
 
 
 def _program():
@@ -164,14 +165,15 @@ def _texture_bytes(model) -> tuple:
 
 def scaling_rows(*, counts, degrees, window, repeats, progress=True):
     """Frame time and texture memory against the number of patches and against the degree."""
-    from datasets_synthetic.nurbs_models import degree_patch, patch_tiling, vase
+    from datasets_synthetic.nurbs_models import degree_patch, patch_tiling
+    from datasets_synthetic.teapot import newell_teapot
 
     camera = [(1.0, -1.8, 2.2), (1.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
     out = []
-    jobs = [("patches", c) for c in counts] + [("vase", 32)] + [("degree", p) for p in degrees]
+    jobs = [("patches", c) for c in counts] + [("teapot", 32)] + [("degree", p) for p in degrees]
     for kind, k in progress_bar(jobs, "nurbs: scaling", enabled=progress):
-        model = {"patches": patch_tiling, "degree": degree_patch, "vase": lambda n: vase()}[kind](k)
-        view = [(3.2, -3.2, 3.0), (0.0, 0.0, 1.2), (0.0, 0.0, 1.0)] if kind == "vase" else camera
+        model = {"patches": patch_tiling, "degree": degree_patch, "teapot": lambda n: newell_teapot()}[kind](k)
+        view = TEAPOT_CAMERA if kind == "teapot" else camera
         t0 = time.perf_counter()
         pl = _scene(window, view)
         pl.add_nurbs(model, lights=1)
