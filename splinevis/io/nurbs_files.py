@@ -13,7 +13,7 @@
 Conventions kept by every reader
 --------------------------------
 * Each patch keeps its identity: ``NurbsSurface.name`` is the file's object name or id (Rhino), the
-  entity label or directory sequence number (IGES), the face's index (STEP), the patch index (text).
+  entity label or directory sequence number (IGES), the face's stored name, else its owner's name and index (STEP, through OpenCASCADE's XCAF document), the patch index (text).
 * Trim loops come in the patch's own ``(u, v)`` domain, as lists of :class:`~splinevis.nurbs.TrimCurve`;
   the model applies the even-odd rule, so loop orientation does not matter.
 * Entities the reader does not turn into surfaces are counted in ``NurbsModel.skipped`` (entity type ->

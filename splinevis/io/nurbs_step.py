@@ -6,17 +6,35 @@ OCP comes from the optional extra ``cad`` (``pip install cadquery-ocp-novtk``, ~
 What is read
 ------------
 Every face of the transferred shape whose surface is a ``Geom_BSplineSurface`` (also under a
-``Geom_RectangularTrimmedSurface``) becomes one patch named ``"face <k>"`` (k counts the faces in the
-shape's order). Periodic surfaces are unrolled to their non-periodic form (same points). The face's
-wires become its trim loops: each edge's curve on the surface (its "pcurve", trimmed to the edge's
-range) converted to a 2-D B-spline with ``Geom2dConvert``, in the surface's own ``(u, v)`` domain. Faces
-on other surfaces (planes, cylinders, ... not converted to NURBS by the writer) are counted in
-``skipped`` as ``"face on Geom_Plane"`` etc. The face orientation (a reversed face flips the normal) is
-not applied: the patch keeps the surface's parametrization.
+``Geom_RectangularTrimmedSurface``) becomes one patch, in the shape's face order. Periodic surfaces are
+unrolled to their non-periodic form (same points). The face's wires become its trim loops: each edge's
+curve on the surface (its "pcurve", trimmed to the edge's range) converted to a 2-D B-spline with
+``Geom2dConvert``, in the surface's own ``(u, v)`` domain. A reversed face (its outside the surface's back)
+is mirrored in v (trims with it) so that ``S_u x S_v`` points out. Faces on other surfaces (planes,
+cylinders, ... not converted to NURBS by the writer) are counted in ``skipped`` as ``"face on Geom_Plane"``.
+
+Names
+-----
+The file is read into an XCAF document (``STEPCAFControl_Reader`` with name mode on and the static
+``read.stepcaf.subshapes.name`` set to 1 for the call, so named representation items get sub-shape
+labels). The free shapes of ``XCAFDoc_ShapeTool`` are walked (assembly components to the parts they refer
+to, each part to its sub-shape labels), and each face takes the ``TDataStd_Name`` of its own label: the
+name of its ``ADVANCED_FACE('name', ...)``. A face without one is named after the nearest named owner, a
+named solid or shell sub-shape, else its part (product) or assembly: ``"bracket / face 3"``; without any,
+``"face <k>"``. ``k`` counts the faces in the shape's order either way. Empty names, and the placeholders
+OpenCASCADE gives unnamed shapes (product names ``"Open CASCADE STEP translator ..."`` from its STEP
+writer, the shape type, ``"SOLID"``, ``"COMPOUND"``, ..., from XCAF's auto-naming), count as no name.
+Faces are matched to labels by their underlying ``TopoDS_TShape`` (locations and orientation aside), so
+every instance of a part carries the part's names. The shape itself is the XCAF reader's own
+``STEPControl_Reader`` result, so faces, order, trims and orientation are what the plain reader gives. If
+the XCAF document cannot be built (its modules missing, the transfer failing), the file is read with the
+plain ``STEPControl_Reader``: faces are named ``"face <k>"``, a UserWarning says why and ``source`` says
+``"names not read"``.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +70,10 @@ def _quiet_occ() -> None:
 
 
 def read_step(path) -> NurbsModel:
-    """Read the B-spline faces of a STEP file (with their trim loops) through OCP.
+    """Read the B-spline faces of a STEP file (with their trim loops and stored names) through OCP.
+
+    Names come from the file's XCAF document: a face's own name, else ``"<part> / face <k>"``, else
+    ``"face <k>"`` (see the module notes); without XCAF the plain reader is used, with a warning.
 
     Raises
     ------
@@ -73,8 +94,8 @@ def read_step(path) -> NurbsModel:
     ...     f = str(Path(folder) / "box.step")
     ...     w = STEPControl_Writer(); _ = w.Transfer(box, STEPControl_AsIs); _ = w.Write(f)
     ...     m = read_step(f)
-    >>> len(m), m.bounds()
-    (6, (0.0, 1.0, 0.0, 2.0, 0.0, 3.0))
+    >>> len(m), m.bounds(), m.names[:2]  # the file names no face: "face <k>"
+    (6, (0.0, 1.0, 0.0, 2.0, 0.0, 3.0), ('face 0', 'face 1'))
     """
     path = Path(path)
     try:
@@ -83,11 +104,191 @@ def read_step(path) -> NurbsModel:
     except ImportError:
         raise ImportError(f"{path}: reading STEP files needs OpenCASCADE's Python bindings (OCP): {OCP_HINT}.") from None
     _quiet_occ()
-    reader = STEPControl_Reader()
-    if reader.ReadFile(str(path)) != IFSelect_RetDone:
-        raise ValueError(f"{path}: OpenCASCADE could not read this file as STEP; is it a valid ISO 10303-21 file?")
-    reader.TransferRoots()
-    return shape_to_model(reader.OneShape(), path, "STEP (OCP)", {})
+    try:
+        shape, names = _read_xcaf(path)
+    except _Unreadable:
+        raise
+    except Exception as err:  # noqa: BLE001 -- any XCAF failure: read the geometry without names, and say so
+        why = f"{type(err).__name__}: {err}"
+        warnings.warn(f"{path}: face names not read, OpenCASCADE's XCAF document could not be built ({why}); "
+                      "read with the plain STEPControl_Reader.", UserWarning, stacklevel=2)
+        reader = STEPControl_Reader()
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise _Unreadable(_unreadable(path)) from None
+        reader.TransferRoots()
+        return shape_to_model(reader.OneShape(), path, f"STEP (OCP, plain reader; names not read: {why})", {})
+    skipped = {}
+    surfaces, trims = shape_faces(shape, path, skipped, names=names.name)
+    return build_model(path, "STEP (OCP)", surfaces, trims, skipped)
+
+
+class _Unreadable(ValueError):
+    """The file is not STEP (no point in a second reader)."""
+
+
+def _unreadable(path) -> str:
+    return f"{path}: OpenCASCADE could not read this file as STEP; is it a valid ISO 10303-21 file?"
+
+
+def _read_xcaf(path: Path):
+    """``(shape, FaceNames)``: the file through ``STEPCAFControl_Reader`` into an XCAF document; the shape is
+    the reader's own ``STEPControl_Reader`` result (what the plain path reads)."""
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.Interface import Interface_Static
+    from OCP.STEPCAFControl import STEPCAFControl_Reader
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFApp import XCAFApp_Application
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    reader = STEPCAFControl_Reader()  # defines the static below (its controller's first use)
+    reader.SetNameMode(True)
+    key = "read.stepcaf.subshapes.name"
+    before = Interface_Static.IVal_s(key)
+    Interface_Static.SetIVal_s(key, 1)
+    try:
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            raise _Unreadable(_unreadable(path))
+        app = XCAFApp_Application.GetApplication_s()
+        doc = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+        app.InitDocument(doc)
+        if not reader.Transfer(doc):
+            raise RuntimeError("STEPCAFControl_Reader.Transfer failed")
+    finally:
+        Interface_Static.SetIVal_s(key, before)
+    names = _FaceNames()
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+    free = _label_sequence()
+    tool.GetFreeShapes(free)
+    for i in range(1, free.Length() + 1):
+        _walk(free.Value(i), "", names)
+    return reader.ChangeReader().OneShape(), names
+
+
+def _label_sequence():
+    try:  # OCP 8
+        from OCP.OCP.collections import Sequence_TDF_Label
+    except ImportError:
+        try:
+            from OCP.collections import Sequence_TDF_Label
+        except ImportError:  # OCP 7.7 and earlier
+            from OCP.TDF import TDF_LabelSequence as Sequence_TDF_Label
+    return Sequence_TDF_Label()
+
+
+#: Product names OpenCASCADE's STEP writer makes up for unnamed shapes: no name.
+_PLACEHOLDER = "Open CASCADE STEP translator"
+#: The names XCAF's auto-naming gives unnamed shapes (their type), e.g. written as PRODUCT('SOLID'): no name.
+_AUTO_NAMES = {"ASSEMBLY", "COMPOUND", "COMPSOLID", "SOLID", "SHELL", "FACE", "WIRE", "EDGE", "VERTEX", "SHAPE"}
+
+
+def _label_name(label) -> str:
+    """The label's ``TDataStd_Name`` ("" without one, or for a writer's placeholder)."""
+    from OCP.TDataStd import TDataStd_Name
+
+    attr = TDataStd_Name()
+    if not label.FindAttribute(TDataStd_Name.GetID_s(), attr):
+        return ""
+    name = attr.Get().ToExtString().strip()
+    return "" if name.startswith(_PLACEHOLDER) or name in _AUTO_NAMES else name
+
+
+def _walk(label, owner: str, names) -> None:
+    """Record the names of the faces under an XCAF shape label (see the module notes)."""
+    from OCP.TDF import TDF_Label
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.XCAFDoc import XCAFDoc_ShapeTool as Tool
+
+    if Tool.IsReference_s(label):
+        referred = TDF_Label()
+        if not Tool.GetReferredShape_s(label, referred):
+            return
+        label = referred
+    owner = _label_name(label) or owner
+    if Tool.IsAssembly_s(label):
+        components = _label_sequence()
+        Tool.GetComponents_s(label, components, False)
+        for i in range(1, components.Length() + 1):
+            _walk(components.Value(i), owner, names)
+        return
+    if owner:
+        for face in _faces(Tool.GetShape_s(label)):
+            names.add(face, owner=owner)
+    subs = _label_sequence()
+    Tool.GetSubShapes_s(label, subs)
+    for i in range(1, subs.Length() + 1):
+        name = _label_name(subs.Value(i))
+        shape = Tool.GetShape_s(subs.Value(i))
+        if not name or shape.IsNull():
+            continue
+        if shape.ShapeType() == TopAbs_FACE:  # the face's own name
+            names.add(shape, own=name)
+        else:  # a named solid, shell, ...: the closest owner of its faces
+            for face in _faces(shape):
+                names.add(face, owner=name, inner=True)
+
+
+class _FaceNames:
+    """Names of OCP faces, matched by their underlying ``TopoDS_TShape`` (location and orientation aside):
+    each face's own name, and the name of the (innermost named) shape that owns it.
+
+    >>> from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    >>> from OCP.gp import gp_Trsf, gp_Vec
+    >>> from OCP.TopLoc import TopLoc_Location
+    >>> box = BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape()
+    >>> names = _FaceNames()
+    >>> for face in _faces(box):
+    ...     names.add(face, owner="box")
+    >>> names.add(_faces(box)[2], own="lid")
+    >>> shift = gp_Trsf(); shift.SetTranslation(gp_Vec(5.0, 0.0, 0.0))
+    >>> moved = box.Moved(TopLoc_Location(shift))  # another instance: the same faces, elsewhere
+    >>> [names.name(face, k) for k, face in enumerate(_faces(moved))][1:3]
+    ['box / face 1', 'lid']
+    """
+
+    def __init__(self):
+        self._table = {}  # hash of the unlocated forward face -> [[face, own, owner], ...]
+
+    def _entry(self, face, create: bool):
+        from OCP.TopAbs import TopAbs_FORWARD
+        from OCP.TopLoc import TopLoc_Location
+
+        key = face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
+        bucket = self._table.setdefault(hash(key), []) if create else self._table.get(hash(key), [])
+        for entry in bucket:
+            if entry[0].IsSame(key):
+                return entry
+        if not create:
+            return None
+        bucket.append([key, "", ""])
+        return bucket[-1]
+
+    def add(self, face, own: str = "", owner: str = "", inner: bool = False) -> None:
+        """Record a face's own name, or its owner's (kept if one is known, unless ``inner``: a closer owner)."""
+        entry = self._entry(face, True)
+        if own:
+            entry[1] = own
+        if owner and (inner or not entry[2]):
+            entry[2] = owner
+
+    def name(self, face, k: int):
+        """The face's own name, else ``"<owner> / face <k>"``, else None."""
+        entry = self._entry(face, False)
+        if entry is None:
+            return None
+        return entry[1] or (f"{entry[2]} / face {k}" if entry[2] else None)
+
+
+def _faces(shape) -> list:
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    faces = []
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        faces.append(explorer.Current())
+        explorer.Next()
+    return faces
 
 
 def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
@@ -118,11 +319,13 @@ def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
     return build_model(path, kind, surfaces, trims, skipped)
 
 
-def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
+def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None) -> tuple:
     """``(surfaces, trims)`` of an OCP shape's B-spline faces; other faces are counted in ``skipped``.
 
-    Faces are named ``"<prefix> face <k>"`` (``"face <k>"`` without a prefix); a shape with a single
-    face names it ``prefix`` itself when one is given.
+    Faces are named ``names(face, k)`` when that gives a name (``names``: a function of the
+    ``TopoDS_Face`` and its index ``k`` in the shape, returning a str or None), else
+    ``"<prefix> face <k>"`` (``"face <k>"`` without a prefix); a shape with a single face names it
+    ``prefix`` itself when one is given.
 
     >>> from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
     >>> from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
@@ -130,6 +333,9 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
     >>> surfaces, trims = shape_faces(box, "box", {}, prefix="box")
     >>> [s.name for s in surfaces][:2], len(trims[0]), len(trims[0][0])  # one wire of four edges
     (['box face 0', 'box face 1'], 1, 4)
+    >>> surfaces, _ = shape_faces(box, "box", {}, names=lambda face, k: "lid" if k == 5 else None)
+    >>> [s.name for s in surfaces][4:]
+    ['face 4', 'lid']
     """
     from OCP.BRep import BRep_Tool
     from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
@@ -143,7 +349,8 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "") -> tuple:
         explorer.Next()
     surfaces, trims = [], []
     for k, face in enumerate(faces):
-        name = prefix if (prefix and len(faces) == 1) else (f"{prefix} face {k}" if prefix else f"face {k}")
+        name = (names(face, k) if names is not None else None) or (
+            prefix if (prefix and len(faces) == 1) else (f"{prefix} face {k}" if prefix else f"face {k}"))
         surf = BRep_Tool.Surface_s(face)
         if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
             surf = surf.BasisSurface()
