@@ -9,6 +9,7 @@
 // large residual.
 #include "lib/core/raycast.glsl"
 #include "lib/nurbs/basis.glsl"
+#include "lib/nurbs/poles.glsl"
 #ifdef SV_NURBS_TRIM
 #include "lib/nurbs/trim.glsl"
 // sv_trim_index (declared by VTK): per patch (first piece / 4096, first piece % 4096, piece count, -)
@@ -36,7 +37,9 @@ float sv_nurbs_tolerance(SvNurbsPatch P, vec3 Su, vec3 Sv, vec3 ro) {
 
 // uv - lambda step with lambda <= 1 the largest that goes at most half way to an open edge: never onto it (a
 // collapsed edge, a pole, has S_u = 0 and would stop the iteration); splinevis.nurbs.raycast.EDGE_STEP. A step
-// over a pole of a patch closed in the other parameter goes on over the pole, half a turn on.
+// over a pole of a patch closed in the other parameter goes on over the pole (splinevis.nurbs.raycast._step):
+// half a turn on where the pole has half-turn symmetry (exact there), else to the antipodal meridian of the
+// step's end (lib/nurbs/poles.glsl, derivation in splinevis/nurbs/poles.py).
 vec2 sv_nurbs_step(vec2 uv, vec2 step, vec2 lo, vec2 hi, SvNurbsPatch P) {
     float lam = 1.0;
     vec2 nw = uv - step;
@@ -45,14 +48,22 @@ vec2 sv_nurbs_step(vec2 uv, vec2 step, vec2 lo, vec2 hi, SvNurbsPatch P) {
     for (int i = 0; i < 2; ++i) {
         if (!open_edge[i]) continue;
         int o = 1 - i;
-        if (closed[o]) {  // over a pole of a patch closed the other way: on along the meridian, half a turn on
+        if (closed[o]) {  // over a pole of a patch closed the other way: on along the meridian, on the far side
             bool over_lo = nw[i] < lo[i] && (P.poles & (1 << (2 * i))) != 0;
             bool over_hi = nw[i] > hi[i] && (P.poles & (2 << (2 * i))) != 0;
             if (over_lo || over_hi) {
                 float end = over_lo ? lo[i] : hi[i];
-                uv[i] = 2.0 * end - uv[i];
-                step[i] = -step[i];
-                uv[o] += 0.5 * (hi[o] - lo[o]);
+                int edge = 2 * i + (over_lo ? 0 : 1);
+                if ((P.poles & (16 << edge)) == 0) {  // half-turn symmetry: exact as it stands
+                    uv[i] = 2.0 * end - uv[i];
+                    step[i] = -step[i];
+                    uv[o] += 0.5 * (hi[o] - lo[o]);
+                } else {  // uv - step = (end + rho (end - nw), t'): t' the antipode of the step's end nw[o]
+                    vec2 c = sv_nurbs_cross_pole(P, edge, nw[o], lo[o], hi[o]);
+                    uv[i] = end + (end - uv[i]) * c.y;
+                    step[i] = -step[i] * c.y;
+                    uv[o] = c.x + step[o];
+                }
                 nw = uv - step;
             }
         }

@@ -1,7 +1,8 @@
 """Scenes where the float32 NURBS fragment program is most likely to part from its float64 twin
 (:class:`splinevis.gl.contract.HardCase`): poles (a collapsed row: S_u = 0), seams at knot values, a C0 crease
 (an interior knot of multiplicity p), degree 7, tiny and huge patches, coordinates around 1e6, a grazing
-view and a camera inside the bounding box."""
+view, a camera inside the bounding box, the Newell teapot's poles (real data), and poles without half-turn symmetry (a Newton step over the pole must
+go on along the antipodal meridian, not half a turn on: :mod:`splinevis.nurbs.poles`)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from .exact import saddle, sphere, torus
 from .model import NurbsModel
 from .surface import NurbsSurface
 
-__all__ = ["crease", "degree7", "bumpy", "trimmed_plate", "hard_cases"]
+__all__ = ["crease", "degree7", "bumpy", "trimmed_plate", "unequal_arcs_sphere", "hard_cases"]
 
 
 def crease() -> NurbsSurface:
@@ -92,6 +93,40 @@ def bumpy(p: int, q: int, nu: int, nv: int, x0: float = 0.0) -> NurbsSurface:
     return NurbsSurface((p, q), (clamped(p, nu), clamped(q, nv)), P, W, name=f"bumpy{p}{q}")
 
 
+def unequal_arcs_sphere(arcs=(150.0, 90.0, 60.0, 60.0), radius: float = 1.0) -> NurbsSurface:
+    """The unit sphere, exactly, but its u circle made of four arcs of unequal angles (degrees, summing to 360;
+    each a rational quadratic: middle point on the tangents' meet, weight cos(angle / 2) [PieglTiller1997,
+    sec. 7.5]) over equal knot spans: the meridian half a turn on in u is not the antipodal one (at u = 0, the
+    +x meridian, the antipode -x is at u = 0.25 + 0.25 * 30 / 90 in angle, not 0.5), so the old half-turn rule
+    over the poles lands up to ~60 degrees off.
+
+    >>> s = unequal_arcs_sphere()
+    >>> u, v = np.linspace(0, 1, 7), np.linspace(0, 1, 7)
+    >>> bool(np.abs(np.linalg.norm(s.evaluate(u, v), axis=1) - 1).max() < 1e-15), s.shape
+    (True, (9, 5))
+    """
+    base = sphere(radius)
+    phi = np.radians(np.concatenate([[0.0], np.cumsum(arcs)]))
+    if abs(phi[-1] - 2 * np.pi) > 1e-12 or len(arcs) != 4 or max(arcs) >= 180:
+        raise ValueError(f"arcs must be four angles below 180 summing to 360 degrees, got {arcs!r}.")
+    xy, wc = [], []
+    for a, b in zip(phi[:-1], phi[1:]):
+        h, m = 0.5 * (b - a), 0.5 * (a + b)
+        xy += [[np.cos(a), np.sin(a)], [np.cos(m) / np.cos(h), np.sin(m) / np.cos(h)]]
+        wc += [1.0, np.cos(h)]
+    xy, wc = np.array(xy + [[1.0, 0.0]]), np.array(wc + [1.0])
+    rho, z = base.control_points[0, :, 0], base.control_points[0, :, 2]
+    P = np.stack([xy[:, None, 0] * rho, xy[:, None, 1] * rho, np.broadcast_to(z, (9, len(z)))], axis=-1)
+    return NurbsSurface((2, 2), (base.knots[0], base.knots[1]), P, np.outer(wc, base.weights[0]),
+                        name="unequal-arcs-sphere")
+
+
+def _teapot():
+    from datasets_synthetic.teapot import newell_teapot  # real data: the Newell teapot's 32 patches
+
+    return newell_teapot()
+
+
 def _scaled(r, c):
     return lambda: NurbsModel([sphere(r, c)])
 
@@ -123,4 +158,16 @@ def hard_cases() -> list:
         HardCase("seams-at-knots", lambda: NurbsModel([torus()]), [(6.0, 0.0, 0.0), (0, 0, 0), (0, 0, 1)]),
         HardCase("trimmed-hole-and-island", trimmed_plate, [(0.3, -2.2, 2.4), (0.0, 0.0, 0.0), (0, 0, 1)]),
         HardCase("trim-edge-1000x-zoom", trimmed_plate, _trim_zoom_camera, clipping_range=(1e-4, 1.0)),
+        # close to the south pole of a sphere whose u circle is four unequal arcs: fragments near the pole start on
+        # the wrong side of it (the shell is pushed outward), Newton steps over the pole and must go on along the
+        # antipodal meridian (the pole table), not half a turn on. 16 steps: a view this close to a pole converges
+        # slowly however the pole is crossed (the equal-arc sphere has as many slow pixels here); with the
+        # half-turn rule 39 depths leave the bound (99.73%, failing), with the antipode rule 7 (99.95%)
+        # real data: the Newell teapot seen from above and from below; four patches, each a quarter turn (open in
+        # u), meet at the knob's pole and at the bottom's centre (a step over those poles cannot go on in the same
+        # patch: the neighbour's fragments must cover it), seams with only G1, handle and spout through the body
+        HardCase("teapot-knob-pole", _teapot, [(0.3, -0.4, 6.0), (0.0, 0.0, 2.5), (0, 1, 0)]),
+        HardCase("teapot-bottom-pole", _teapot, [(0.5, -0.4, -4.0), (0.0, 0.0, 0.5), (0, 1, 0)]),
+        HardCase("pole-without-half-turn-symmetry", lambda: NurbsModel([unequal_arcs_sphere()]),
+                 [(0.25, 0.1, -1.15), (0.0, 0.0, -1.0), (0, 1, 0)], newton_iterations=16),
     ]

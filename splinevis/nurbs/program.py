@@ -8,8 +8,10 @@ Tables (RGBA32F, :func:`splinevis.gl.proxies.pack_rgba32f`):
   ``(hi, lo)`` with ``offset = 4096 hi + lo`` (both parts exact in float32, so offsets stay exact far beyond
   2^24); the control-point offset ``(hi, lo)`` and the closed-in-u / closed-in-v flags; the patch magnitude M
   and the largest |knot| (the shader's float32 tolerance, :func:`splinevis.nurbs.raycast.residual_tolerance`)
-  and the collapsed edges (poles) as bits u=lo, u=hi, v=lo, v=hi;
-* ``sv_nurbs_knots``: all knot vectors, one float each;
+  and the collapsed edges (poles) as bits u=lo, u=hi, v=lo, v=hi (1, 2, 4, 8), plus ``16 << edge`` where that
+  pole has an antipode table (no half-turn symmetry: :mod:`splinevis.nurbs.poles`);
+* ``sv_nurbs_knots``: all knot vectors, one float each; after a patch's V knots, its pole tables (lower edge
+  first, :func:`splinevis.nurbs.poles.pole_table`: the pole normal and POLE_TABLE + 1 antipode offsets);
 * ``sv_nurbs_cps``: homogeneous control points ``(w (P - offset), w)``, one texel each (model frame: world
   minus the box centre, so coordinates around 1e6 never reach float32).
 """
@@ -50,11 +52,14 @@ def nurbs_tables(model: NurbsModel) -> dict:
         (p, q), (U, V) = s.degree, s.knots
         nu, nv = s.shape
         ku, kv = nk, nk + len(U)
+        tables = [t for t in f["pole_tables"] if t is not None]
+        bits = sum(b << i for i, b in enumerate(f["poles"])) + sum(16 << i for i, t in enumerate(f["pole_tables"])
+                                                                   if t is not None)
         header += [p, q, nu, nv, ku // _SPLIT, ku % _SPLIT, kv // _SPLIT, kv % _SPLIT,
                    ncp // _SPLIT, ncp % _SPLIT, float(f["closed"][0]), float(f["closed"][1]),
-                   f["magnitude"], f["knot_max"], float(sum(b << i for i, b in enumerate(f["poles"]))), 0.0]
-        knots += [U, V]
-        nk += len(U) + len(V)
+                   f["magnitude"], f["knot_max"], float(bits), 0.0]
+        knots += [U, V, *tables]
+        nk += len(U) + len(V) + sum(len(t) for t in tables)
         w = np.ones(s.shape) if s.weights is None else s.weights
         cps.append(np.concatenate([(s.control_points - off) * w[..., None], w[..., None]], axis=-1).reshape(-1, 4))
         ncp += nu * nv

@@ -18,6 +18,7 @@ import numpy as np
 from ..gl.contract import RayHits
 from ..gl.error_bounds import U32, depth_error, model_frame_matrix
 from .model import NurbsModel
+from .poles import cross_pole, pole_tables
 from .surface import NurbsSurface
 from .tessellate import span_grid
 
@@ -62,7 +63,8 @@ def _poles(s: NurbsSurface) -> tuple:
 def patch_facts(model) -> list:
     """Per patch: dict with ``closed`` (u, v), ``magnitude`` M = max |P - offset| * max w / min w (model frame)
     and ``knot_max`` = largest |knot|: what the float32 tolerances of the shader are built from; ``poles``: which
-    edges (u=lo, u=hi, v=lo, v=hi) collapse to a point.
+    edges (u=lo, u=hi, v=lo, v=hi) collapse to a point; ``pole_tables``: per edge, the antipode table of a pole
+    without half-turn symmetry (:func:`splinevis.nurbs.poles.pole_tables`) or None.
 
     >>> from splinevis.nurbs.exact import sphere
     >>> f = patch_facts(NurbsModel([sphere()]))[0]
@@ -76,8 +78,9 @@ def patch_facts(model) -> list:
         w = np.ones(s.shape) if s.weights is None else s.weights
         mag = float(np.linalg.norm(s.control_points - off, axis=-1).max() * w.max() / w.min())
         kmax = float(max(np.abs(s.knots[0]).max(), np.abs(s.knots[1]).max()))
-        out.append({"closed": (_closed(s, 0), _closed(s, 1)), "magnitude": mag, "knot_max": kmax,
-                    "poles": _poles(s)})
+        closed, poles = (_closed(s, 0), _closed(s, 1)), _poles(s)
+        out.append({"closed": closed, "magnitude": mag, "knot_max": kmax, "poles": poles,
+                    "pole_tables": pole_tables(s, closed, poles)})
     return out
 
 
@@ -228,9 +231,11 @@ def _chord_deviation(s, us, vs, margin, k=8):
 EDGE_STEP = 0.5
 
 
-def _step(s, closed, poles, x, step):
+def _step(s, closed, poles, x, step, tables=(None,) * 4):
     """x - lambda step, lambda <= 1 the largest that goes at most EDGE_STEP of the way to an open edge; a step
-    over a pole of a patch closed in the other parameter continues on the meridian half a turn on."""
+    over a pole of a patch closed in the other parameter continues on the far side of the pole: on the meridian
+    half a turn on where the pole has half-turn symmetry (no table), else on the antipodal meridian t' of the
+    step's end t_e at rho times its distance beyond the pole (:func:`splinevis.nurbs.poles.cross_pole`)."""
     lam = np.ones(len(x))
     x, step = x.copy(), step.copy()
     for axis in (0, 1):
@@ -239,13 +244,19 @@ def _step(s, closed, poles, x, step):
         lo, hi = s.domain[axis]
         new = x[:, axis] - step[:, axis]
         other = 1 - axis
-        if closed[other]:  # across a pole of a patch closed the other way: over the pole, half a turn on
+        if closed[other]:  # across a pole of a patch closed the other way: over the pole, on the far side
             half = 0.5 * (s.domain[other][1] - s.domain[other][0])
-            for end, pole in ((lo, poles[2 * axis]), (hi, poles[2 * axis + 1])):
-                over = ((new < lo) if end == lo else (new > hi)) & pole
-                x[over, axis] = 2 * end - x[over, axis]
-                step[over, axis] *= -1
-                x[over, other] += half
+            for end, edge in ((lo, 2 * axis), (hi, 2 * axis + 1)):
+                over = ((new < lo) if end == lo else (new > hi)) & poles[edge]
+                if tables[edge] is None:  # half-turn symmetry: exact as it stands
+                    x[over, axis] = 2 * end - x[over, axis]
+                    step[over, axis] *= -1
+                    x[over, other] += half
+                elif over.any():  # x' - step' = (t', end + rho (end - new)): t' = antipode of the step's end
+                    tp, rho = cross_pole(s, edge, tables[edge], x[over, other] - step[over, other])
+                    x[over, axis] = end + (end - x[over, axis]) * rho
+                    step[over, axis] *= -rho
+                    x[over, other] = tp + step[over, other]
             new = x[:, axis] - step[:, axis]
         with np.errstate(divide="ignore", invalid="ignore"):
             lam = np.where(new < lo, np.minimum(lam, EDGE_STEP * (x[:, axis] - lo) / (x[:, axis] - new)), lam)
@@ -299,7 +310,7 @@ def newton_on_rays(model, patch, uv, origins, directions, iterations: int):
         sel = np.flatnonzero(patch == k)
         if not sel.size:
             continue
-        closed, poles = facts[k]["closed"], facts[k]["poles"]
+        closed, poles, tables = facts[k]["closed"], facts[k]["poles"], facts[k]["pole_tables"]
         x = _into_domain(s, closed, uv[sel])
         a1, a2, oo = n1[sel], n2[sel], o[sel]
         for _ in range(iterations):
@@ -312,7 +323,7 @@ def newton_on_rays(model, patch, uv, origins, directions, iterations: int):
             ok = det != 0
             safe = np.where(ok, det, 1.0)
             step = np.stack([j22 * F[:, 0] - j12 * F[:, 1], -j21 * F[:, 0] + j11 * F[:, 1]], axis=-1) / safe[:, None]
-            x = np.where(ok[:, None], _step(s, closed, poles, x, step), x)
+            x = np.where(ok[:, None], _step(s, closed, poles, x, step, tables), x)
         d = s.derivatives(x[:, 0], x[:, 1], 1)
         d[:, 0, 0] -= off
         e = d[:, 0, 0] - oo

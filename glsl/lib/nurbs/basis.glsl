@@ -5,8 +5,10 @@
 //                     (hi, lo, hi, lo) with offset = hi * 4096 + lo (each part exact in float32, so offsets up to
 //                     2^36 stay exact); texel 2 = control-point offset (hi, lo), closed-in-u, closed-in-v;
 //                     texel 3 = (patch magnitude M, largest |knot|) for the float32 tolerances, and the
-//                     collapsed edges (poles) as bits 1: u=lo, 2: u=hi, 4: v=lo, 8: v=hi.
-//   sv_nurbs_knots  : all knot vectors, one float each (read with sv_table_float).
+//                     collapsed edges (poles) as bits 1: u=lo, 2: u=hi, 4: v=lo, 8: v=hi, and (16 << edge)
+//                     where that pole has an antipode table (no half-turn symmetry: lib/nurbs/poles.glsl).
+//   sv_nurbs_knots  : all knot vectors, one float each (read with sv_table_float); after a patch's V knots,
+//                     its pole tables (lower edge first).
 //   sv_nurbs_cps    : homogeneous control points (w (P - offset), w), one texel each, P[k, l] at k * nv + l.
 // Loops run to the constant SV_NURBS_MAX_DEGREE and leave early at the patch's degree (no switch per degree).
 #include "lib/core/table.glsl"
