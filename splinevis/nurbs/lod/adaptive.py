@@ -50,7 +50,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .bounds import collapsed_point, curve_chord_bounds, curve_points, patch_points, side_net, triangle_bounds
+from .bounds import (_chord_bounds_many, _curve_points_rows, _patch_points_many, collapsed_point, side_net,
+                     triangle_bounds)
 
 __all__ = ["Tessellation", "curve_chain", "adaptive_tessellation", "barycentric_grid"]
 
@@ -106,23 +107,34 @@ def curve_chain(Pw_side, delta: float, samples: int = 33, max_depth: int = 40) -
     ([0.0, 1.0], 9)
     """
     Pw = np.asarray(Pw_side, dtype=np.float64)
-    delta = _check_delta(delta)
-    t = np.array([0.0, 1.0])
-    if collapsed_point(Pw) is not None:
-        return t
+    return _curve_chains(Pw[None], np.array([_check_delta(delta)]), samples, max_depth)[0]
+
+
+def _curve_chains(nets, delta, samples: int = 33, max_depth: int = 40) -> list:
+    """:func:`curve_chain` of the curves ``nets (E, p + 1, 4)`` (one degree) with tolerances ``delta (E,)``, refined
+    in lockstep (row by row the same operations: bitwise the chains of one call each)."""
+    E = nets.shape[0]
     s = np.arange(1, samples + 1) / (samples + 1.0)
+    live = np.array([collapsed_point(C) is None for C in nets], dtype=bool)
+    eid, t = np.repeat(np.arange(E), 2), np.tile([0.0, 1.0], E)  # the chains, sorted by (curve, parameter)
     for _ in range(max_depth):
-        need = (curve_chord_bounds(Pw, t) > delta) & (np.diff(t) > 4 * np.finfo(float).eps)
+        k = np.flatnonzero((eid[:-1] == eid[1:]) & live[eid[:-1]])  # segments [t[k], t[k + 1]]
+        t0, t1, ek = t[k], t[k + 1], eid[k]
+        need = (_chord_bounds_many(nets, ek, t0, t1) > delta[ek]) & (t1 - t0 > 4 * np.finfo(float).eps)
         if not need.any():
             break
-        t0, t1 = t[:-1][need], t[1:][need]
+        t0, t1, ek = t0[need], t1[need], ek[need]
         tt = t0[:, None] + s[None, :] * (t1 - t0)[:, None]
-        C = curve_points(Pw, tt.ravel()).reshape(tt.shape + (-1,))
-        E0, E1 = curve_points(Pw, t0), curve_points(Pw, t1)
+        C = _curve_points_rows(nets[np.repeat(ek, s.size)], tt.ravel()).reshape(tt.shape + (-1,))
+        E0, E1 = _curve_points_rows(nets[ek], t0), _curve_points_rows(nets[ek], t1)
         chord = E0[:, None, :] + s[None, :, None] * (E1 - E0)[:, None, :]
         best = np.clip(s[np.argmax(np.linalg.norm(C - chord, axis=-1), axis=1)], 0.125, 0.875)
-        t = np.union1d(t, t0 + best * (t1 - t0))
-    return t
+        eid, t = np.concatenate([eid, ek]), np.concatenate([t, t0 + best * (t1 - t0)])
+        order = np.lexsort((t, eid))
+        eid, t = eid[order], t[order]
+        keep = np.concatenate([[True], (eid[1:] != eid[:-1]) | (t[1:] != t[:-1])])
+        eid, t = eid[keep], t[keep]
+    return np.split(t, np.cumsum(np.bincount(eid, minlength=E))[:-1])
 
 
 def _check_delta(delta) -> float:
@@ -167,44 +179,6 @@ def _rotate(tri: np.ndarray, k: np.ndarray) -> np.ndarray:
     return tri[r, (k[:, None] + np.arange(3)) % 3]
 
 
-class _Mesh:
-    """Growing vertex and triangle arrays (domain points, their points in space, depth, bound)."""
-
-    def __init__(self, Pw, uv, tri):
-        self.Pw = Pw
-        self.uv = np.asarray(uv, dtype=np.float64)
-        self.X = patch_points(Pw, self.uv)
-        self.tri = np.asarray(tri, dtype=np.int64).reshape(-1, 3)
-        self.depth = np.zeros(self.tri.shape[0], dtype=np.int64)
-        self.bound = np.full(self.tri.shape[0], np.nan)
-        self.prev = np.full(self.tri.shape[0], np.inf)  # the bound of the triangle it was split from
-
-    def add_points(self, uv):
-        start = self.uv.shape[0]
-        self.uv = np.concatenate([self.uv, uv])
-        self.X = np.concatenate([self.X, patch_points(self.Pw, uv)])
-        return start + np.arange(uv.shape[0])
-
-    def replace(self, rows, first, extra, depth):
-        """Triangles ``rows`` become ``first``; ``extra`` (list of arrays) are appended; all get ``depth``."""
-        parent = self.bound[rows].copy()
-        self.tri[rows] = first
-        self.depth[rows] = depth
-        self.bound[rows] = np.nan
-        self.prev[rows] = parent
-        for e in extra:
-            self.tri = np.concatenate([self.tri, e])
-            self.depth = np.concatenate([self.depth, depth])
-            self.bound = np.concatenate([self.bound, np.full(e.shape[0], np.nan)])
-            self.prev = np.concatenate([self.prev, parent])
-
-    def update_bounds(self):
-        todo = np.flatnonzero(np.isnan(self.bound))
-        if todo.size:
-            t = self.tri[todo]
-            self.bound[todo] = triangle_bounds(self.Pw, self.uv[t], self.X[t])
-
-
 def _snap(p, a, b):
     """Points ``p`` on segments ``a b``: a coordinate equal at both ends is that coordinate exactly."""
     return np.where(a == b, a, p)
@@ -215,27 +189,6 @@ def _edge_side(uv: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     out = np.full(a.shape, -1, dtype=np.int64)
     for k, (axis, value, _) in enumerate(_SIDES):
         out[(uv[a, axis] == value) & (uv[b, axis] == value)] = k
-    return out
-
-
-def _end_targets(uv, tri, chains, seg_bound, fixed, delta) -> np.ndarray:
-    """``(T,)`` target ``delta + b`` of triangles with a vertex on a fixed chain segment with curve bound
-    ``b > delta`` lying in the band along the side as deep as 1/8 of that segment's length, else ``delta``."""
-    out = np.full(tri.shape[0], delta)
-    for k, (axis, value, run) in enumerate(_SIDES):
-        if not fixed[k] or not (seg_bound[k] > delta).any():
-            continue
-        on = np.flatnonzero(uv[:, axis] == value)
-        i = np.searchsorted(chains[k], uv[on, run])  # the vertex is chain[i] exactly
-        sb = np.concatenate([[-np.inf], seg_bound[k], [-np.inf]])
-        ln = np.concatenate([[0.0], np.diff(chains[k]), [0.0]])
-        vb, vl = np.full(uv.shape[0], -np.inf), np.zeros(uv.shape[0])
-        vb[on] = np.maximum(sb[i], sb[i + 1])
-        vl[on] = np.where(sb[i] >= sb[i + 1], ln[i], ln[i + 1])
-        depth = np.abs(uv[tri, axis] - value).max(axis=1)
-        j = np.argmax(vb[tri], axis=1)
-        tb, tl = vb[tri][np.arange(tri.shape[0]), j], vl[tri][np.arange(tri.shape[0]), j]
-        out = np.where((tb > delta) & (depth <= tl / 8.0), np.maximum(out, delta + tb), out)
     return out
 
 
@@ -258,48 +211,154 @@ def adaptive_tessellation(Pw, delta: float, chains=None, samples: int = 9, max_d
     Pw = np.asarray(Pw, dtype=np.float64)
     if Pw.ndim != 3 or Pw.shape[2] != 4 or min(Pw.shape[:2]) < 2:
         raise ValueError(f"Pw must be homogeneous control points (m + 1, n + 1, 4) with m, n >= 1, got {Pw.shape}.")
-    delta = _check_delta(delta)
-    chains = _check_chains(chains)
-    nets = [side_net(Pw, k) for k in range(4)]
-    fixed = [c is not None and collapsed_point(nets[k]) is None for k, c in enumerate(chains)]
-    seg_bound = [curve_chord_bounds(nets[k], c) if fixed[k] else None for k, c in enumerate(chains)]
-    limits = {k: float(b.max()) for k, b in enumerate(seg_bound) if b is not None and b.max() > delta}
-    converged = True
+    return _tessellate([(Pw, _check_delta(delta), _check_chains(chains))], samples, max_depth, quality,
+                       max_triangles)[0]
+
+
+class _Chains:
+    """The chains of one side over a batch of patches (None where the side is not fixed): lookups of
+    ``np.searchsorted(chain[p], x)`` for many ``(p, x)`` at once, exactly (through ranks of the values)."""
+
+    def __init__(self, chains, seg_bound):
+        n = len(chains)
+        lens = np.array([0 if c is None else c.size for c in chains], dtype=np.int64)
+        self.off = np.concatenate([[0], np.cumsum(lens)])
+        self.c = np.concatenate([np.zeros(0)] + [c for c in chains if c is not None])
+        self.U = np.unique(self.c)
+        self.big = self.U.size + 2
+        self.key = np.repeat(np.arange(n), lens) * self.big + np.searchsorted(self.U, self.c)
+        self.seg = np.concatenate([np.zeros(0)] + [b for b in seg_bound if b is not None])  # segment k of p:
+        self.soff = np.concatenate([[0], np.cumsum(np.maximum(lens - 1, 0))])  # seg[soff[p] + k]
+
+    def right(self, p, x):
+        r = np.searchsorted(self.U, x, side="right") - 1
+        return np.searchsorted(self.key, p * self.big + r, side="right") - self.off[p]
+
+    def left(self, p, x):
+        r = np.searchsorted(self.U, x, side="left")
+        return np.searchsorted(self.key, p * self.big + r, side="left") - self.off[p]
+
+
+def _end_targets(uv, vp, tri, ch, delta_t, delta, fixed) -> np.ndarray:
+    """``(T,)`` target ``delta + b`` of triangles with a vertex on a fixed chain segment with curve bound
+    ``b > delta`` lying in the band along the side as deep as 1/8 of that segment's length, else ``delta``
+    (``vp``: the patch of each vertex, ``ch``: the :class:`_Chains` per side, ``delta (I,)`` per patch)."""
+    out = delta_t.copy()
+    for k, (axis, value, run) in enumerate(_SIDES):
+        c = ch[k]
+        big = np.zeros(len(delta), dtype=bool)  # patches with a fixed side k and a segment above delta
+        if c.seg.size:
+            owner = np.repeat(np.arange(len(delta)), np.diff(c.soff))
+            np.logical_or.at(big, owner, c.seg > delta[owner])
+        big &= fixed[:, k]
+        if not big.any():
+            continue
+        on = np.flatnonzero((uv[:, axis] == value) & big[vp])
+        p = vp[on]
+        i = c.left(p, uv[on, run])  # the vertex is chain[i] exactly
+        first, last = i == 0, i == np.diff(c.off)[p] - 1
+        s0 = c.soff[p] + i  # segment i (after the vertex) and i - 1 (before)
+        sb0 = np.where(first, -np.inf, c.seg[np.maximum(s0 - 1, 0)])
+        sb1 = np.where(last, -np.inf, c.seg[np.minimum(s0, c.seg.size - 1)])
+        cc = c.c[c.off[p] + i]
+        ln0 = np.where(first, 0.0, cc - c.c[np.maximum(c.off[p] + i - 1, 0)])
+        ln1 = np.where(last, 0.0, c.c[np.minimum(c.off[p] + i + 1, c.c.size - 1)] - cc)
+        vb, vl = np.full(uv.shape[0], -np.inf), np.zeros(uv.shape[0])
+        vb[on] = np.maximum(sb0, sb1)
+        vl[on] = np.where(sb0 >= sb1, ln0, ln1)
+        depth = np.abs(uv[tri, axis] - value).max(axis=1)
+        j = np.argmax(vb[tri], axis=1)
+        tb, tl = vb[tri][np.arange(tri.shape[0]), j], vl[tri][np.arange(tri.shape[0]), j]
+        out = np.where((tb > delta_t) & (depth <= tl / 8.0), np.maximum(out, delta_t + tb), out)
+    return out
+
+
+def _tessellate(items, samples: int = 9, max_depth: int = 40, quality: float = 0.5,
+                max_triangles: int = 200_000) -> list:
+    """:func:`adaptive_tessellation` of many patches of one degree at once (``items``: ``(Pw, delta, chains)``,
+    checked), refined in lockstep: every array operation works row by row, so each patch's result is bitwise
+    the one it gets alone (the order of its vertices and triangles included)."""
+    I = len(items)
+    Pws = np.stack([it[0] for it in items])
+    delta = np.array([it[1] for it in items], dtype=np.float64)
+    fixed = np.zeros((I, 4), dtype=bool)
+    poles = [(np.zeros(I, dtype=bool), np.zeros((I, 3))) for _ in range(4)]
+    side_chains, side_bounds, limits = [[None] * I for _ in range(4)], [[None] * I for _ in range(4)], []
+    for p, (Pw, d, chains) in enumerate(items):
+        lim = {}
+        for k in range(4):
+            net = side_net(Pw, k)
+            pole = collapsed_point(net)
+            if pole is not None:
+                poles[k][0][p], poles[k][1][p] = True, pole
+            if chains[k] is not None and pole is None:
+                fixed[p, k] = True
+                side_chains[k][p] = chains[k]
+        limits.append(lim)
+    for k in range(4):  # the curve bounds of every fixed side's chain segments, all patches at once
+        rows = np.flatnonzero(fixed[:, k])
+        if rows.size:
+            lens = np.array([side_chains[k][p].size - 1 for p in rows])
+            t = np.concatenate([side_chains[k][p] for p in rows])
+            start = np.ones(t.size - 1, dtype=bool)
+            start[np.cumsum(lens + 1)[:-1] - 1] = False  # no segment from one chain's end to the next one's start
+            b = _chord_bounds_many(np.stack([side_net(Pws[p], k) for p in rows]), np.repeat(np.arange(rows.size), lens),
+                                   t[:-1][start], t[1:][start])
+            for p, bp in zip(rows, np.split(b, np.cumsum(lens)[:-1])):
+                side_bounds[k][p] = bp
+    for p in range(I):
+        for k in range(4):
+            b = side_bounds[k][p]
+            if b is not None and b.max() > delta[p]:
+                limits[p][k] = float(b.max())
+    ch = [_Chains(side_chains[k], side_bounds[k]) for k in range(4)]
+    results = [None] * I
 
     # 1. two triangles, the diagonal with the smaller larger bound
-    options = (np.array([[0, 1, 2], [0, 2, 3]]), np.array([[0, 1, 3], [1, 2, 3]]))
-    worst = [triangle_bounds(Pw, _CORNERS[o], patch_points(Pw, _CORNERS)[o]).max() for o in options]
-    mesh = _Mesh(Pw, _CORNERS, options[int(np.argmin(worst))])
+    options = np.array([[[0, 1, 2], [0, 2, 3]], [[0, 1, 3], [1, 2, 3]]])
+    X = _patch_points_many(Pws, poles, np.repeat(np.arange(I), 4), np.tile(_CORNERS, (I, 1)))
+    t4 = (np.arange(I)[:, None, None, None] * 4 + options[None]).reshape(-1, 3)  # (I * 4, 3): option, triangle
+    worst = triangle_bounds(Pws[np.repeat(np.arange(I), 4)], np.tile(_CORNERS, (I, 1))[t4], X[t4])
+    choice = np.argmin(worst.reshape(I, 2, 2).max(axis=2), axis=1)
+    m = _BatchMesh(Pws, np.tile(_CORNERS, (I, 1)), X, np.repeat(np.arange(I), 4),
+                   (np.arange(I)[:, None, None] * 4 + options[choice]).reshape(-1, 3), np.repeat(np.arange(I), 2),
+                   poles)
 
     grid = barycentric_grid(samples)
-    while True:
-        mesh.update_bounds()
-        tri, uv = mesh.tri, mesh.uv
+    while m.tri.shape[0]:
+        m.update_bounds()
+        tri, uv, tp = m.tri, m.uv, m.tp
         T = tri.shape[0]
+        delta_t = delta[tp]
+        count = np.bincount(tp, minlength=I)[tp]
         a, b = tri, np.roll(tri, -1, axis=1)
         side = _edge_side(uv, a, b)  # (T, 3)
         is_fixed = np.zeros_like(side, dtype=bool)  # on a chain segment (final)
         pend = np.zeros_like(side, dtype=bool)  # on a fixed side, chain points still inside
         pend_t = np.zeros(side.shape)  # the chain point nearest the middle of a pending edge
-        target = np.full(T, delta)
         seg = np.full(side.shape, -np.inf)  # the curve bound of each fixed edge's chain segment
         for k in range(4):
-            on = side == k
-            if fixed[k] and on.any():
-                run, c = _SIDES[k][2], chains[k]
+            on = (side == k) & fixed[tp, k][:, None]
+            if on.any():
+                run, c = _SIDES[k][2], ch[k]
+                p = np.broadcast_to(tp[:, None], side.shape)[on]
                 lo = np.minimum(uv[a[on], run], uv[b[on], run])
                 hi = np.maximum(uv[a[on], run], uv[b[on], run])
-                i_lo, i_hi = np.searchsorted(c, lo, side="right"), np.searchsorted(c, hi, side="left")
+                i_lo, i_hi = c.right(p, lo), c.left(p, hi)
                 inside = i_hi > i_lo  # chain points c[i_lo:i_hi] lie strictly inside the edge
                 mid = 0.5 * (lo + hi)
-                j = np.clip(np.searchsorted(c, mid), i_lo, np.maximum(i_hi - 1, i_lo))  # first >= mid, or the last
-                j = np.where((j > i_lo) & (np.abs(c[j - 1] - mid) < np.abs(c[j] - mid)), j - 1, j)
+                j = np.clip(c.left(p, mid), i_lo, np.maximum(i_hi - 1, i_lo))  # first >= mid, or the last
+                o = c.off[p]
+                j = np.where((j > i_lo) & (np.abs(c.c[np.maximum(o + j - 1, 0)] - mid) < np.abs(c.c[o + j] - mid)),
+                             j - 1, j)
                 pend[on], is_fixed[on] = inside, ~inside
-                pend_t[on] = c[j]
-                seg[on] = np.where(inside, -np.inf, seg_bound[k][np.maximum(i_lo - 1, 0)])
+                pend_t[on] = c.c[o + j]
+                seg[on] = np.where(inside, -np.inf, c.seg[np.minimum(c.soff[p] + np.maximum(i_lo - 1, 0),
+                                                                     max(c.seg.size - 1, 0))])
         # delta + b on and at the ends of a too coarse segment (b > delta): the region along it cannot do better
-        target = np.maximum(target, np.where(seg > delta, delta + seg, delta).max(axis=1))
-        target = np.maximum(target, _end_targets(uv, tri, chains, seg_bound, fixed, delta))
+        target = np.maximum(delta_t, np.where(seg > delta_t[:, None], delta_t[:, None] + seg,
+                                              delta_t[:, None]).max(axis=1))
+        target = np.maximum(target, _end_targets(uv, m.vp, tri, ch, delta_t, delta, fixed))
         # a triangle on a fixed segment, already thin across it, whose last split gained under 1 %: its bound
         # has reached what the segment allows
         V = uv[tri]
@@ -307,24 +366,46 @@ def adaptive_tessellation(Pw, delta: float, chains=None, samples: int = 9, max_d
         l2 = np.einsum("tki,tki->tk", e, e)
         area2 = np.abs(e[:, 0, 0] * e[:, 1, 1] - e[:, 0, 1] * e[:, 1, 0])
         thin = (is_fixed & (area2[:, None] <= l2 / 16.0)).any(axis=1)  # height <= |edge| / 16
-        stuck = thin & (mesh.bound >= 0.99 * mesh.prev) & (mesh.bound > target)
-        over = (mesh.bound > target) & ~stuck
+        stuck = thin & (m.bound >= 0.99 * m.prev) & (m.bound > target)
+        over = (m.bound > target) & ~stuck
         pending = pend.any(axis=1)
-        need = np.flatnonzero((over & (mesh.depth < max_depth) & (T < max_triangles)) | pending)
-        if need.size == 0:
-            converged = not over.any()
-            done = stuck | (mesh.bound > delta)
-            for k in range(4):
-                hit = (side == k) & done[:, None] & is_fixed
-                if hit.any():
-                    limits[k] = max(limits.get(k, -np.inf), float(seg[hit].max()))
-            break
+        needs = (over & (m.depth < max_depth) & (count < max_triangles)) | pending
+        busy = np.zeros(I, dtype=bool)
+        busy[tp[needs]] = True
+        present = np.zeros(I, dtype=bool)
+        present[tp] = True
+        finished = np.flatnonzero(present & ~busy)
+        if finished.size:
+            done = stuck | (m.bound > delta_t)
+            for q in finished:
+                rows = np.flatnonzero(tp == q)
+                lim = limits[q]
+                for k in range(4):
+                    hit = (side[rows] == k) & done[rows][:, None] & is_fixed[rows]
+                    if hit.any():
+                        lim[k] = max(lim.get(k, -np.inf), float(seg[rows][hit].max()))
+                results[q] = Tessellation(*m.extract(q, rows), lim, not over[rows].any())
+            keep = busy[tp]
+            m.drop(keep)
+            if not keep.any():
+                break
+            sel = np.flatnonzero(keep)
+            tri, uv, tp = m.tri, m.uv, m.tp
+            T = tri.shape[0]
+            side, is_fixed, pend, pend_t = side[sel], is_fixed[sel], pend[sel], pend_t[sel]
+            pending, needs, l2 = pending[sel], needs[sel], l2[sel]
+        need = np.flatnonzero(needs)
         # 2. the point of largest sampled deviation of each triangle that needs a split
+        # (a triangle keeps its sample while it is not split: it depends on its vertices only)
         V = uv[tri[need]]  # (N, 3, 2)
-        P = grid @ V  # (N, S, 2)
-        F = patch_points(Pw, P.reshape(-1, 2)).reshape(P.shape[:2] + (3,))
-        dev = np.linalg.norm(F - grid @ mesh.X[tri[need]], axis=-1)
-        bc = grid[np.argmax(dev, axis=1)]  # (N, 3)
+        new = need[m.best[need] < 0]
+        if new.size:
+            P = grid @ uv[tri[new]]  # (N, S, 2)
+            F = _patch_points_many(Pws, poles, np.repeat(tp[new], grid.shape[0]),
+                                   P.reshape(-1, 2)).reshape(P.shape[:2] + (3,))
+            dev = np.linalg.norm(F - grid @ m.X[tri[new]], axis=-1)
+            m.best[new] = np.argmax(dev, axis=1)
+        bc = grid[m.best[need]]  # (N, 3)
         zero = bc == 0
         nz = zero.sum(axis=1)
         kind_edge = nz == 1
@@ -361,10 +442,11 @@ def adaptive_tessellation(Pw, delta: float, chains=None, samples: int = 9, max_d
             mid = _snap(0.5 * (va + vb), va, vb)
             at = _snap(np.where(np.abs(vb - va) > 0, pend_t[need, kp][:, None], va), va, vb)
             point = np.where(tall[:, None], mid, np.where(chain_split[:, None], at, point))
-        # 3. a conflict-free subset: each request goes if it comes first at every triangle it touches
+        # 3. a conflict-free subset: each request goes if it comes first at every triangle it touches (requests
+        # of different patches never touch a common triangle: the global order is each patch's own)
         nb = _neighbours(tri, uv.shape[0])[need, edge]
         other = np.where(kind_edge & (nb >= 0), nb // 3, -1)
-        order = np.argsort(np.where(pn, -np.inf, -mesh.bound[need]), kind="stable")
+        order = np.argsort(np.where(pn, -np.inf, -m.bound[need]), kind="stable")
         rank = np.empty(need.size, dtype=np.int64)
         rank[order] = np.arange(need.size)
         first = np.full(T, need.size, dtype=np.int64)
@@ -372,13 +454,76 @@ def adaptive_tessellation(Pw, delta: float, chains=None, samples: int = 9, max_d
         has = other >= 0
         np.minimum.at(first, other[has], rank[has])
         go = (first[need] == rank) & (~has | (first[np.maximum(other, 0)] == rank))
-        _apply(mesh, need[go], edge[go], kind_edge[go], other[go], np.where(has[go], nb[go] % 3, 0), point[go])
-    return Tessellation(mesh.uv, mesh.tri, mesh.bound, limits, bool(converged))
+        _apply(m, need[go], edge[go], kind_edge[go], other[go], np.where(has[go], nb[go] % 3, 0), point[go])
+    return results
 
 
-def _apply(mesh: _Mesh, rows, edge, kind_edge, other, other_edge, point):
+class _BatchMesh:
+    """The growing meshes of a batch of patches: vertices (domain points, points in space, patch ``vp``) and
+    triangles (global vertex ids, patch ``tp``, depth, bound, the bound of the triangle split into it)."""
+
+    def __init__(self, Pws, uv, X, vp, tri, tp, poles=None):
+        self.Pws, self.poles = Pws, poles
+        self.uv, self.X, self.vp = uv, X, vp
+        self.tri, self.tp = tri.astype(np.int64), tp
+        self.depth = np.zeros(tri.shape[0], dtype=np.int64)
+        self.bound = np.full(tri.shape[0], np.nan)
+        self.prev = np.full(tri.shape[0], np.inf)
+        self.best = np.full(tri.shape[0], -1, dtype=np.int64)  # the sample of largest deviation, -1: not yet
+
+    def add_points(self, uv, X, vp):
+        start = self.uv.shape[0]
+        self.uv, self.X = np.concatenate([self.uv, uv]), np.concatenate([self.X, X])
+        self.vp = np.concatenate([self.vp, vp])
+        return start + np.arange(uv.shape[0])
+
+    def replace(self, rows, first, extra, depth):
+        """Triangles ``rows`` become ``first``; ``extra`` (list of arrays) are appended; all get ``depth``."""
+        parent = self.bound[rows].copy()
+        self.tri[rows] = first
+        self.depth[rows] = depth
+        self.bound[rows] = np.nan
+        self.prev[rows] = parent
+        self.best[rows] = -1
+        tp = self.tp[rows]
+        for e in extra:
+            self.tri = np.concatenate([self.tri, e])
+            self.best = np.concatenate([self.best, np.full(e.shape[0], -1, dtype=np.int64)])
+            self.tp = np.concatenate([self.tp, tp])
+            self.depth = np.concatenate([self.depth, depth])
+            self.bound = np.concatenate([self.bound, np.full(e.shape[0], np.nan)])
+            self.prev = np.concatenate([self.prev, parent])
+
+    def update_bounds(self, chunk: int = 1 << 14):
+        todo = np.flatnonzero(np.isnan(self.bound))
+        for a in range(0, todo.size, chunk):
+            rows = todo[a:a + chunk]
+            t = self.tri[rows]
+            self.bound[rows] = triangle_bounds(self.Pws[self.tp[rows]], self.uv[t], self.X[t])
+
+    def extract(self, q, rows):
+        """``(uv, triangles, bound)`` of patch ``q`` (its triangles ``rows``) in its own vertex numbering."""
+        verts = np.flatnonzero(self.vp == q)
+        local = np.full(self.uv.shape[0], -1, dtype=np.int64)
+        local[verts] = np.arange(verts.size)
+        return self.uv[verts], local[self.tri[rows]], self.bound[rows]
+
+    def drop(self, keep):
+        """Keep the triangles ``keep`` (whole patches) and their patches' vertices."""
+        alive = np.zeros(self.Pws.shape[0], dtype=bool)
+        alive[self.tp[keep]] = True
+        vkeep = alive[self.vp]
+        new = np.cumsum(vkeep) - 1
+        self.uv, self.X, self.vp = self.uv[vkeep], self.X[vkeep], self.vp[vkeep]
+        self.tri = new[self.tri[keep]]
+        for name in ("tp", "depth", "bound", "prev", "best"):
+            setattr(self, name, getattr(self, name)[keep])
+
+
+def _apply(mesh: _BatchMesh, rows, edge, kind_edge, other, other_edge, point):
     """Split: interior points 1 -> 3, edge points 1 -> 2 on both sides of the edge."""
-    ids = mesh.add_points(point)
+    vp = mesh.tp[rows]
+    ids = mesh.add_points(point, _patch_points_many(mesh.Pws, mesh.poles, vp, point), vp)
     d = mesh.depth[rows] + 1
     tri = mesh.tri
     inner = ~kind_edge

@@ -89,6 +89,8 @@ not ``F(p_k)``: ``G(p_k) = w (F(p_k) - F_k)``, whose linear interpolant adds ``m
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .bezier import bernstein
@@ -100,16 +102,45 @@ __all__ = ["subdivide", "second_derivative_bounds", "enclosing_radius", "waldron
 EPS = np.finfo(float).eps
 
 
+def _bernstein_table(m: int, t: np.ndarray) -> np.ndarray:
+    """``(N, m + 1, m + 2)``: row ``d`` holds ``B_i^d(t)`` for ``i <= d`` and zeros after (one zero column
+    more), by the recurrence of :func:`splinevis.nurbs.lod.bezier.bernstein` with the same roundings (the
+    padded zeros add exactly: ``x + 0 = x``), so each row equals ``bernstein(d, t)`` bitwise."""
+    s = 1.0 - t
+    T = np.zeros((t.size, m + 1, m + 2))
+    T[:, 0, 0] = 1.0
+    for d in range(1, m + 1):
+        np.multiply(s[:, None], T[:, d - 1, :d], out=T[:, d, :d])
+        T[:, d, 1:d + 1] += t[:, None] * T[:, d - 1, :d]
+    return T
+
+
+@lru_cache(maxsize=None)
+def _diagonal_index(m: int):
+    """``(m + 1, m + 1)`` index ``i - j`` (``m + 1``, a zero column of :func:`_bernstein_table`, where ``i < j``)."""
+    j, i = np.meshgrid(np.arange(m + 1), np.arange(m + 1), indexing="ij")
+    return np.where(i >= j, i - j, m + 1)
+
+
 def _subdivision_matrix(m: int, a, b) -> np.ndarray:
     """``S (N, m + 1, m + 1)`` with ``Q = S P`` the Bernstein coefficients on ``[a, b]`` of the degree-m
     polynomial with coefficients ``P`` on ``[0, 1]``: ``S_ki = sum_j B_j^(m-k)(a) B_(i-j)^k(b)`` (the blossom
-    at ``a^(m-k) b^k``). Entries are non-negative and rows sum to 1 for ``0 <= a <= b <= 1``."""
+    at ``a^(m-k) b^k``). Entries are non-negative and rows sum to 1 for ``0 <= a <= b <= 1``.
+
+    The sum runs over ``j`` in increasing order from 0 (the terms outside ``0 <= i - j <= k``, ``j <= m - k``
+    are exact zeros), the rounding of the textbook double loop.
+
+    >>> _subdivision_matrix(2, [0.0], [0.5])[0].tolist()
+    [[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.25, 0.5, 0.25]]
+    """
     a, b = np.atleast_1d(np.asarray(a, dtype=np.float64)), np.atleast_1d(np.asarray(b, dtype=np.float64))
-    S = np.zeros((a.size, m + 1, m + 1))
-    for k in range(m + 1):
-        Ba, Bb = bernstein(m - k, a), bernstein(k, b)
-        for j in range(m - k + 1):
-            S[:, k, j:j + k + 1] += Ba[:, j:j + 1] * Bb
+    N = a.size
+    T = _bernstein_table(m, np.concatenate([a, b]))
+    Ta, Tb = T[:N, ::-1, :m + 1], T[N:]  # Ta[:, k, j] = B_j^(m-k)(a), Tb[:, k, l] = B_l^k(b)
+    Z = Ta[..., None] * Tb[:, :, _diagonal_index(m)]  # (N, k, j, i)
+    S = Z[:, :, 0, :].copy()
+    for j in range(1, m + 1):
+        S += Z[:, :, j, :]
     return S
 
 
@@ -228,27 +259,35 @@ def box_bound(tri, M) -> np.ndarray:
     return kumar_bound(ext[..., 0], ext[..., 1], M)
 
 
-def _elevate(Q: np.ndarray, axis: int) -> np.ndarray:
-    """Degree raising by one along ``axis`` (a non-negative axis of ``Q``)."""
-    m = Q.shape[axis] - 1
-    shape = [1] * Q.ndim
+@lru_cache(maxsize=None)
+def _raise_weights(m: int, axis: int, ndim: int):
+    shape = [1] * ndim
     shape[axis] = m + 2
     a = (np.arange(m + 2) / (m + 1)).reshape(shape)
-    pad = [(0, 0)] * Q.ndim
-    lo, hi = list(pad), list(pad)
-    lo[axis], hi[axis] = (1, 0), (0, 1)
-    return a * np.pad(Q, lo) + (1.0 - a) * np.pad(Q, hi)
+    return a, 1.0 - a
+
+
+def _shifted(Q: np.ndarray, axis: int, first: bool) -> np.ndarray:
+    """``Q`` with one zero slice added along ``axis`` in front (``first``) or at the end (``np.pad``)."""
+    shape = list(Q.shape)
+    shape[axis] += 1
+    out = np.zeros(shape)
+    idx = [slice(None)] * Q.ndim
+    idx[axis] = slice(1, None) if first else slice(0, -1)
+    out[tuple(idx)] = Q
+    return out
+
+
+def _elevate(Q: np.ndarray, axis: int) -> np.ndarray:
+    """Degree raising by one along ``axis`` (a non-negative axis of ``Q``)."""
+    a, b = _raise_weights(Q.shape[axis] - 1, axis, Q.ndim)
+    return a * _shifted(Q, axis, True) + b * _shifted(Q, axis, False)
 
 
 def _times_param(Q: np.ndarray, axis: int) -> np.ndarray:
     """Coefficients of ``s * Q(s)`` one degree up along ``axis``: ``(s Q)_k = k / (m + 1) Q_(k - 1)``."""
-    m = Q.shape[axis] - 1
-    shape = [1] * Q.ndim
-    shape[axis] = m + 2
-    a = (np.arange(m + 2) / (m + 1)).reshape(shape)
-    pad = [(0, 0)] * Q.ndim
-    pad[axis] = (1, 0)
-    return a * np.pad(Q, pad)
+    a = _raise_weights(Q.shape[axis] - 1, axis, Q.ndim)[0]
+    return a * _shifted(Q, axis, True)
 
 
 def _bernstein_eval(P: np.ndarray, t) -> np.ndarray:
@@ -295,6 +334,33 @@ def patch_points(Pw, uv) -> np.ndarray:
         if on.any():
             C = side_net(Pw, side)
             out[on] = pole if (pole := collapsed_point(C)) is not None else curve_points(C, t[on])
+    return out
+
+
+def _patch_points_many(Pws: np.ndarray, poles, item: np.ndarray, uv: np.ndarray, chunk: int = 1 << 15) -> np.ndarray:
+    """:func:`patch_points` of many patches ``Pws (I, m + 1, n + 1, 4)`` of one degree at once: point ``k`` of
+    patch ``item[k]`` at ``uv[k]``; ``poles`` per side ``(is_pole (I,), pole (I, 3))`` (:func:`collapsed_point`).
+    Row by row the same operations in the same order as :func:`patch_points`: bitwise the same points."""
+    u, v = uv[:, 0], uv[:, 1]
+    m, n = Pws.shape[1] - 1, Pws.shape[2] - 1
+    out = np.empty((uv.shape[0], 3))
+    for a in range(0, uv.shape[0], chunk):
+        b = min(a + chunk, uv.shape[0])
+        A = np.einsum("ki,kj,kijc->kc", bernstein(m, u[a:b]), bernstein(n, v[a:b]), Pws[item[a:b]])
+        out[a:b] = A[:, :3] / A[:, 3:]
+    for side, (on, t) in enumerate(((v == 0, u), (u == 1, v), (v == 1, u), (u == 0, v))):
+        rows = np.flatnonzero(on)
+        if rows.size:
+            it = item[rows]
+            is_pole, pole = poles[side]
+            res = np.empty((rows.size, 3))
+            sel = is_pole[it]
+            res[sel] = pole[it[sel]]
+            cur = np.flatnonzero(~sel)
+            if cur.size:
+                C = (Pws[:, :, 0], Pws[:, -1, :], Pws[:, :, -1], Pws[:, 0, :])[side][it[cur]]  # (K, p + 1, 4)
+                res[cur] = _curve_points_rows(C, t[rows[cur]])
+            out[rows] = res
     return out
 
 
@@ -413,10 +479,26 @@ def curve_chord_bounds(Pw_curve, t) -> np.ndarray:
     """
     Pw = np.asarray(Pw_curve, dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)
-    p = Pw.shape[0] - 1
-    S = _subdivision_matrix(p, t[:-1], t[1:])
-    Q = np.einsum("Nki,ic->Nkc", S, Pw)  # (N, p+1, k+1)
-    F0, F1 = curve_points(Pw, t[:-1]), curve_points(Pw, t[1:])
+    return _chord_bounds_many(Pw[None], np.zeros(t.size - 1, dtype=np.int64), t[:-1], t[1:])
+
+
+def _curve_points_rows(C: np.ndarray, t) -> np.ndarray:
+    """:func:`curve_points` of the curve ``C[k] (p + 1, k + 1)`` at ``t[k]`` for each row ``k`` (same roundings)."""
+    B = bernstein(C.shape[1] - 1, t)
+    A = B[:, 0, None] * C[:, 0]
+    for i in range(1, C.shape[1]):
+        A = A + B[:, i, None] * C[:, i]
+    return A[:, :-1] / A[:, -1:]
+
+
+def _chord_bounds_many(nets: np.ndarray, e: np.ndarray, t0, t1) -> np.ndarray:
+    """:func:`curve_chord_bounds` of the segments ``[t0[k], t1[k]]`` of the curves ``nets[e[k]]`` (``nets (E, p + 1,
+    k + 1)`` of one degree), row by row the same operations: bitwise the bounds of one call per curve."""
+    Pw = nets[e]
+    p = Pw.shape[1] - 1
+    S = _subdivision_matrix(p, t0, t1)
+    Q = np.einsum("Nki,Nic->Nkc", S, Pw)  # (N, p+1, k+1)
+    F0, F1 = _curve_points_rows(Pw, t0), _curve_points_rows(Pw, t1)
     c = 0.5 * (F0 + F1)
     A = Q[..., :-1] - c[:, None, :] * Q[..., -1:]
     w = Q[..., -1:]
@@ -425,8 +507,8 @@ def curve_chord_bounds(Pw_curve, t) -> np.ndarray:
     if not (wmin > 0).all():
         raise ValueError("the curve's weights are not positive on a segment: it has no chord bound.")
     d2 = np.linalg.norm(G[:, 2:] - 2 * G[:, 1:-1] + G[:, :-2], axis=-1).max(axis=1) if p >= 1 else 0.0
-    wmax = np.abs(Pw[:, -1]).max()
-    size = np.linalg.norm(Pw[:, :-1] / Pw[:, -1:], axis=-1).max()
+    wmax = np.abs(nets[:, :, -1]).max(axis=1)[e]
+    size = np.linalg.norm(nets[:, :, :-1] / nets[:, :, -1:], axis=-1).max(axis=1)[e]
     e_g = 4.0 * (p + 4) * EPS * wmax * (2.0 * size + np.linalg.norm(F0 - c, axis=-1) + np.linalg.norm(F1 - F0, axis=-1))
     e_f = 4.0 * (p + 1) * EPS * size * wmax / wmin
     return 0.125 * (p + 1) * p * d2 / wmin + (0.5 * (p + 2) ** 2 * e_g + wmax * e_f) / wmin

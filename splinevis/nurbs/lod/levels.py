@@ -34,11 +34,14 @@ of levels (tested by vertices and by pixels).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import os
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from .adaptive import adaptive_tessellation, curve_chain
+from .adaptive import _check_chains, _curve_chains, _tessellate, adaptive_tessellation, curve_chain
 from .adjacency import Edges, cluster_points, find_edges
 from .bezier import BezierSet, bezier_set
 from .bounds import curve_points, patch_points, side_net
@@ -51,6 +54,7 @@ _CORNER_UV = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 # the corners at the ends of each side (in the side's increasing parameter): side k runs from
 # _SIDE_ENDS[k][0] to _SIDE_ENDS[k][1] (corner numbers as _CORNER_UV)
 _SIDE_ENDS = ((0, 1), (1, 2), (3, 2), (0, 3))
+_BATCH = 512  # patches tessellated together (lockstep): fewer array operations, bounded memory
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -150,13 +154,22 @@ def _edge_chains(bs, edges, deltas, corner_label):
     _, inv, n = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
     twin = n[inv.ravel()] > 1
     out_t, out_birth = [], []
+    nets = [side_net(bs.control(int(f) // 4), int(f) % 4) for f in edges.edge_side[:len(edges)]]
+    L = deltas.size
+    level_chains = [None] * len(edges)
+    by_shape: dict = {}
+    for e, net in enumerate(nets):
+        by_shape.setdefault(net.shape, []).append(e)
+    for group in by_shape.values():  # every edge at every level at once (bitwise the chains of curve_chain)
+        got = _curve_chains(np.repeat(np.stack([nets[e] for e in group]), L, axis=0), np.tile(deltas, len(group)))
+        for n, e in enumerate(group):
+            level_chains[e] = got[n * L:(n + 1) * L]
     for e in range(len(edges)):
-        f = int(edges.edge_side[e])
-        net = side_net(bs.control(f // 4), f % 4)
-        t = curve_chain(net, deltas[0])
+        net = nets[e]
+        t = level_chains[e][0]
         birth = np.zeros(t.size, dtype=np.int64)
         for level in range(1, deltas.size):
-            birth[np.isin(t, curve_chain(net, deltas[level]))] = level
+            birth[np.isin(t, level_chains[e][level])] = level
         if twin[e] and t.size > 2:
             first = curve_chain(net, 0.99 * float(curve_chord_bounds(net, np.array([0.0, 1.0]))[0]))
             birth[np.isin(t, first)] = deltas.size - 1
@@ -185,7 +198,13 @@ def _shared_vertices(bs, edges, chains, label, corners):
 
 def _patch_level(bs, edges, i, level, deltas, chains, births, edge_ids, corner_label, next_id):
     """One patch at one level: (new interior points, triangles in global ids, next free id)."""
-    Pw = bs.control(i)
+    side_chain, side_ids = _patch_sides(edges, i, level, chains, births, edge_ids, corner_label)
+    tess = adaptive_tessellation(bs.control(i), deltas[level], chains=side_chain)
+    return _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id)
+
+
+def _patch_sides(edges, i, level, chains, births, edge_ids, corner_label):
+    """The chains (parameters along each side) of patch ``i`` at ``level`` and their global vertex ids."""
     side_chain, side_ids = [], []
     for k in range(4):
         e = int(edges.side_edge[i, k])
@@ -199,7 +218,12 @@ def _patch_level(bs, edges, i, level, deltas, chains, births, edge_ids, corner_l
             t, g = 1.0 - t[::-1], g[::-1]
         side_chain.append(t)
         side_ids.append(g)
-    tess = adaptive_tessellation(Pw, deltas[level], chains=side_chain)
+    return side_chain, side_ids
+
+
+def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id):
+    """The tessellation ``tess`` of patch ``i`` in global ids: (new interior points, triangles, next free id)."""
+    Pw = bs.control(i)
     uv = tess.uv
     gid = np.full(uv.shape[0], -1, dtype=np.int64)
     on_side = ((uv[:, 1] == 0.0), (uv[:, 0] == 1.0), (uv[:, 1] == 1.0), (uv[:, 0] == 0.0))
@@ -260,12 +284,13 @@ def _fan_rows(tri, border, edge_ids, births, level):
 
 
 def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha: float = np.radians(30.0),
-              simplify=None, progress: bool = True) -> LodModel:
+              simplify=None, progress: bool = True, workers=None) -> LodModel:
     """Levels of detail of ``model`` (a :class:`~splinevis.nurbs.model.NurbsModel` or one surface) with proven
     bounds ``delta * ratio**l``, ``l = 0..levels-1`` (module docstring). With ``simplify`` (a
     :class:`~splinevis.nurbs.lod.simplify.Simplifier`) the levels ``l > 0`` are decimated across patch edges
     and held to ``delta_l + eps_l`` by measurement. Trim loops are not applied yet: a trimmed patch is
-    tessellated whole.
+    tessellated whole. ``workers`` processes tessellate batches of patches (None: ``os.cpu_count()``; 1: in
+    this process); the result is the same for any number.
 
     >>> from splinevis.nurbs.exact import torus
     >>> lod = build_lod(torus(), 0.02, levels=3, progress=False)
@@ -291,14 +316,37 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     all_points, next_id = [points], points.shape[0]
     meshes, counts = [], np.zeros((S, deltas.size), dtype=np.int64)
     border = _borders(edges, label, S)
-    raw = []
-    for s in tqdm(range(S), desc="lod: tessellation", disable=not progress, unit="super-surface"):
+    # every patch at every level, tessellated in batches of one degree (lockstep refinement: bitwise the
+    # results of one adaptive_tessellation call each), then numbered in the order super-surface, level, patch
+    jobs = [(int(i), level) + _patch_sides(edges, int(i), level, chains, births, edge_ids, corner_label)
+            for s in range(S) for level in range(deltas.size) for i in supers.members[s]]
+    by_degree: dict = {}
+    for n, (i, level, side_chain, _) in enumerate(jobs):
+        by_degree.setdefault(int(bs.group[i]), []).append(n)
+    tess = [None] * len(jobs)
+    workers = max(1, int(os.cpu_count() or 1) if workers is None else int(workers))
+    if len(jobs) < 2 * _BATCH:
+        workers = 1  # not worth starting processes
+    size = max(64, min(_BATCH, -(-len(jobs) // (2 * workers))))
+    parts = [group[a:a + size] for group in by_degree.values() for a in range(0, len(group), size)]
+    batches = ([(bs.control(jobs[n][0]), float(deltas[jobs[n][1]]), _check_chains(jobs[n][2])) for n in part]
+               for part in parts)
+    bar = tqdm(total=len(jobs), desc="lod: tessellation", disable=not progress, unit="patch")
+    with (ProcessPoolExecutor(workers) if workers > 1 else contextlib.nullcontext()) as pool:
+        for part, got in zip(parts, pool.map(_tessellate, batches) if pool else map(_tessellate, batches)):
+            for n, t in zip(part, got):
+                tess[n] = t
+            bar.update(len(part))
+    bar.close()
+    raw, n = [], 0
+    for s in range(S):
         per_level = []
         for level in range(deltas.size):
             tris = []
             for i in supers.members[s]:
-                new, tri, next_id = _patch_level(bs, edges, int(i), level, deltas, chains, births, edge_ids,
-                                                 corner_label, next_id)
+                i, _, side_chain, side_ids = jobs[n]
+                new, tri, next_id = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id)
+                n += 1
                 all_points.append(new)
                 tris.append(tri)
             per_level.append(np.concatenate(tris))
