@@ -31,6 +31,8 @@ WITHOUT_EXAMPLES = {
     "splinevis.studies.volume": {"run_volume_study"},
     # the NURBS study and its parts: dozens of 320x240 to 640x480 scenes, the float64 twin per pixel
     "splinevis.studies.nurbs": {"run_nurbs_study"},
+    # the walkthrough study: builds levels of detail of up to 40,000 patches and flies through them
+    "splinevis.studies.walkthrough": {"run_walkthrough_study"},
     # the showcase's NURBS figure: four 520x390 scenes
     "splinevis.studies.nurbs_demo": {"nurbs_figure"},
     # the sweep: ~24 windows of 200x150 (its window is fixed) even with quick=True, cubic=False, n=8,

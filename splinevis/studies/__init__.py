@@ -11,7 +11,7 @@ scheme is not available), is listed by :func:`notes`.
 Examples
 --------
 >>> sorted(STUDIES)
-['nurbs', 'terrain', 'volume']
+['nurbs', 'terrain', 'volume', 'walkthrough']
 >>> STUDIES["volume"].runner
 'splinevis.studies.volume:run_volume_study'
 """
@@ -82,6 +82,8 @@ STUDIES = {s.name: s for s in (
           "isosurface splines against marching cubes and VTK's volume ray caster"),
     Study("nurbs", "splinevis.studies.nurbs:run_nurbs_study",
           "NURBS zebra stripes per fragment against tessellated meshes (ours and OpenCASCADE's)"),
+    Study("walkthrough", "splinevis.studies.walkthrough:run_walkthrough_study",
+          "large NURBS models at interactive rates: levels of detail, culling, threads [Kumar1997]"),
 )}
 
 
@@ -100,7 +102,7 @@ def get(name: str) -> Study:
     >>> get("sphere")
     Traceback (most recent call last):
     ...
-    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs'.
+    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough'.
     """
     try:
         return STUDIES[name]
