@@ -6,6 +6,8 @@ before VTK makes its first window.
 
 from __future__ import annotations
 
+import os
+
 import difflib
 from dataclasses import fields
 
@@ -96,7 +98,7 @@ class Plotter(pv.Plotter):
 
     def add_spline(self, model, style: Style | None = None, *, name: str | None = None,
                    newton_iterations: int | None = None, program_options: dict | None = None,
-                   **style_options) -> SplineActor:
+                   program: str | None = None, **style_options) -> SplineActor:
         """Add a spline model, drawn exactly per pixel by its program, beside any ordinary meshes.
 
         The model's program is found in the registry (:func:`splinevis.programs.program_for`).
@@ -115,6 +117,9 @@ class Plotter(pv.Plotter):
         program_options : dict, optional
             Options of the model's program (``splinevis.programs.program_for(model).options``, e.g.
             ``{"coefficients_in": "texture"}`` for the analytic patch).
+        program : str, optional
+            A registered program by name where several draw the model's type (``"nurbs_lod"``: levels of
+            detail as one mesh, instead of the per-fragment ``"nurbs"``); default: the model's program.
 
         Returns
         -------
@@ -135,10 +140,12 @@ class Plotter(pv.Plotter):
         TypeError: unknown effect or style option 'reflection_line' (did you mean 'reflection_lines'?); known: ...
         >>> pl.close()
         """
-        from .programs import program_for
+        from .programs import get, program_for
 
         st = _style_from(style, style_options)
-        program = program_for(model)
+        program = program_for(model) if program is None else get(program)
+        if not isinstance(model, (program.model_type, str, os.PathLike) + tuple(program.converts)):
+            raise TypeError(f"program {program.name!r} draws {program.model_type.__name__}, not {type(model).__name__}.")
         if not isinstance(model, program.model_type):  # a type the program converts (SplineProgram.converts)
             model = program.model_from(model)
         built = program.make(model, st, newton_iterations=newton_iterations, **(program_options or {}))

@@ -8,7 +8,7 @@ Examples
 --------
 >>> from splinevis import programs
 >>> [p.name for p in programs.all_programs()]
-['analytic_patch', 'terrain', 'isosurface', 'nurbs']
+['analytic_patch', 'terrain', 'isosurface', 'nurbs_lod', 'nurbs']
 >>> programs.get("terrain").kind
 'raycast'
 """
@@ -23,7 +23,9 @@ __all__ = ["BUILTIN", "register", "unregister", "all_programs", "get", "program_
 
 #: Modules whose ``PROGRAM`` is a built-in family, in listing order.
 BUILTIN = ("splinevis.analytic.program", "splinevis.terrain.program", "splinevis.volume.program",
-           "splinevis.nurbs.program")
+           # two programs draw NURBS models: the level-of-detail meshes first, so that the per-fragment program,
+           # registered later, is the one a NurbsModel finds by type (program_for); the other by name (get)
+           "splinevis.nurbs.lod.program", "splinevis.nurbs.program")
 
 _programs: dict[str, SplineProgram] = {}
 _loaded = False
@@ -86,7 +88,7 @@ def unregister(name: str) -> None:
     False
     >>> unregister("dots")
     Traceback (most recent call last):
-    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface, nurbs."
+    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface, nurbs_lod, nurbs."
     """
     _load_builtin()
     if name not in _programs:
@@ -100,7 +102,8 @@ def all_programs() -> list[SplineProgram]:
     Examples
     --------
     >>> [(p.name, p.kind) for p in all_programs()]
-    [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast'), ('nurbs', 'surface')]
+    [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast'), ('nurbs_lod', 'mesh'),
+     ('nurbs', 'surface')]
     """
     _load_builtin()
     return list(_programs.values())

@@ -135,3 +135,25 @@ def test_simplified_levels_have_fewer_triangles_and_stay_within_their_bound(lods
     # fewer triangles than the proven tessellations of the same super-surfaces at the same level
     unsimplified = build_lod(_fine_torus(), 0.01, levels=LEVELS, alpha=np.radians(100.0), progress=False)
     assert (simple.triangles[:, 1:].sum(axis=0) < unsimplified.triangles[:, 1:].sum(axis=0)).all()
+
+
+@pytest.mark.gl
+def test_the_mesh_program_is_chosen_by_name_and_draws_the_level_it_reports():
+    import splinevis
+    from splinevis import programs
+    from splinevis.analytic import QuarticTrianglePatch
+    from splinevis.nurbs import NurbsModel
+
+    model = NurbsModel([torus()])
+    assert programs.program_for(model).name == "nurbs"  # by type: the per-fragment program
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_spline(model, program="nurbs_lod", program_options={"delta": 0.05, "levels": 2})
+    mesh = actor.GetMapper().GetInput()
+    level = int(mesh.GetFieldData().GetArray("lod_level").GetValue(0))
+    assert level in (0, 1) and mesh.GetNumberOfCells() > 0
+    pl.camera_position = [(4.0, -5.0, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+    img = pl.screenshot()
+    assert (img.sum(axis=-1) < 3 * 250).mean() > 0.1  # the torus covers a good part of the picture
+    with pytest.raises(TypeError, match="program 'nurbs_lod' draws NurbsModel"):
+        pl.add_spline(QuarticTrianglePatch.demo(), program="nurbs_lod")
+    pl.close()

@@ -18,6 +18,7 @@ import numpy as np
 
 from ...gl.contract import HardCase, SplineProgram
 from ..model import NurbsModel
+from ..surface import NurbsSurface
 from ..program import model_from
 
 __all__ = ["lod_mesh", "static_level", "PROGRAM", "FOV_Y", "VIEWPORT_HEIGHT"]
@@ -98,5 +99,6 @@ def _hard_cases():
 
 PROGRAM = SplineProgram(
     name="nurbs_lod", kind="mesh", model_type=NurbsModel, build=_build, hard_cases=_hard_cases, model_from=model_from,
+    converts=(NurbsSurface,),
     options=("delta", "pixel_error", "levels"),
     description="NURBS levels of detail with proven deviation bounds, one crack-free mesh [Kumar1997]")
