@@ -173,3 +173,17 @@ def test_the_shader_follows_the_twin_over_the_poles_of_an_egg():
     r = hard_case_agreement(case)
     assert agreement_failures(r, case) == []
     assert r["leaks"] == 0
+
+
+def test_the_antipode_rule_is_compiled_in_only_for_models_with_an_asymmetric_pole():
+    from datasets_synthetic.nurbs_models import hood
+    from splinevis.gl.assembler import assemble
+    from splinevis.nurbs.exact import sphere
+    from splinevis.nurbs.hard_cases import unequal_arcs_sphere
+    from splinevis.nurbs.program import nurbs_program
+
+    for model, wanted in ((hood(), False), (sphere(), False), (unequal_arcs_sphere(), True)):
+        spec = nurbs_program(model)
+        assert spec.defines.get("SV_NURBS_POLE_TABLES", False) is wanted
+        source = assemble(spec.entry, spec.defines).text
+        assert ("sv_nurbs_cross_pole" in source) is wanted

@@ -9,7 +9,9 @@
 // large residual.
 #include "lib/core/raycast.glsl"
 #include "lib/nurbs/basis.glsl"
+#ifdef SV_NURBS_POLE_TABLES
 #include "lib/nurbs/poles.glsl"
+#endif
 #ifdef SV_NURBS_TRIM
 #include "lib/nurbs/trim.glsl"
 // sv_trim_index (declared by VTK): per patch (first piece / 4096, first piece % 4096, piece count, -)
@@ -54,16 +56,20 @@ vec2 sv_nurbs_step(vec2 uv, vec2 step, vec2 lo, vec2 hi, SvNurbsPatch P) {
             if (over_lo || over_hi) {
                 float end = over_lo ? lo[i] : hi[i];
                 int edge = 2 * i + (over_lo ? 0 : 1);
+#ifdef SV_NURBS_POLE_TABLES
                 if ((P.poles & (16 << edge)) == 0) {  // half-turn symmetry: exact as it stands
+#endif
                     uv[i] = 2.0 * end - uv[i];
                     step[i] = -step[i];
                     uv[o] += 0.5 * (hi[o] - lo[o]);
+#ifdef SV_NURBS_POLE_TABLES
                 } else {  // uv - step = (end + rho (end - nw), t'): t' the antipode of the step's end nw[o]
                     vec2 c = sv_nurbs_cross_pole(P, edge, nw[o], lo[o], hi[o]);
                     uv[i] = end + (end - uv[i]) * c.y;
                     step[i] = -step[i] * c.y;
                     uv[o] = c.x + step[o];
                 }
+#endif
                 nw = uv - step;
             }
         }

@@ -91,13 +91,18 @@ def nurbs_program(model, style=None, *, newton_iterations: int = 12, subdivision
     points, triangles, uv, patch = tessellate(model, int(subdivisions))
     zr = np.asarray(model.bounds()[4:]) - model_offset(model)[2]
     trim = _trim_spec(model)
+    defines = dict(trim.get("defines", {}))
+    if any(t is not None for f in patch_facts(model) for t in f["pole_tables"]):
+        # the antipode rule over asymmetric poles (lib/nurbs/poles.glsl) is compiled in only for models that have
+        # one: inside the Newton loop it doubles llvmpipe's time per fragment even where it never runs
+        defines["SV_NURBS_POLE_TABLES"] = True
     return ProgramSpec(
         name="nurbs", entry="programs/nurbs.glsl", points=points, triangles=triangles,
         uniforms={"sv_newton_iterations": int(newton_iterations), "sv_scalar_range": (float(zr[0]), float(zr[1]))},
         textures={"sv_nurbs_header": pack_rgba32f(t["header"], name="NURBS header"),
                   "sv_nurbs_knots": pack_rgba32f(t["knots"], name="NURBS knots"),
                   "sv_nurbs_cps": pack_rgba32f(t["cps"], name="NURBS control points"), **trim.get("textures", {})},
-        defines=trim.get("defines", {}),
+        defines=defines,
         attributes={"sv_nurbs_patch": patch}, varyings={"sv_nurbs_uv": uv},
         offset=tuple(model_offset(model).tolist()))
 
