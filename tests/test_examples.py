@@ -60,3 +60,15 @@ def test_nurbs_quality_report_finds_the_edited_patch(tmp_path):
     assert "25 patches, 40 seams; 36 G2, 0 G1, 4 G0, 0 open." in md, res.stdout
     img = np.asarray(Image.open(tmp_path / "report.png").convert("RGB")).astype(int)
     assert img.std() > 30
+
+
+@pytest.mark.gl
+def test_walkthrough_example_flies_through_teapots_and_logs_every_frame(tmp_path):
+    res = subprocess.run([sys.executable, str(ROOT / "examples/walkthrough.py"), "4", str(tmp_path)], check=True,
+                         capture_output=True, text=True, cwd=ROOT)
+    assert "128 Bezier patches" in res.stdout and "48 frames: median" in res.stdout
+    rows = (tmp_path / "frames.csv").read_text().splitlines()
+    assert len(rows) == 1 + 48 and rows[0].startswith("frame,time_ms,triangles")
+    assert all(int(r.split(",")[2]) > 0 for r in rows[1:])  # every frame drew triangles
+    img = np.asarray(Image.open(tmp_path / "summary.png").convert("RGB")).astype(int)
+    assert img.shape == (600, 3200, 3) and (~np.all(img > 250, axis=-1)).mean() > 0.1
