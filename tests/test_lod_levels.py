@@ -157,3 +157,18 @@ def test_the_mesh_program_is_chosen_by_name_and_draws_the_level_it_reports():
     with pytest.raises(TypeError, match="program 'nurbs_lod' draws NurbsModel"):
         pl.add_spline(QuarticTrianglePatch.demo(), program="nurbs_lod")
     pl.close()
+
+
+@pytest.mark.parametrize("name", ["sphere", "torus-simplified"])
+def test_vertex_normals_are_the_surface_normals(lods, name):
+    lod = lods[name]
+    n, v = lod.normals, lod.vertices
+    assert n.shape == v.shape
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=4e-16)
+    if name == "sphere":  # outward radius; at the poles the normal is taken 1e-6 inside: within ~1e-6 rad
+        assert (np.einsum("ij,ij->i", n, v / np.linalg.norm(v, axis=1)[:, None]) > 1 - 1e-11).all()
+    else:  # torus (R 2, r 0.5 around z): the normal points from the tube's centre circle to the point
+        c = v * [1.0, 1.0, 0.0]
+        c = 2.0 * c / np.linalg.norm(c, axis=1)[:, None]
+        out = (v - c) / np.linalg.norm(v - c, axis=1)[:, None]
+        assert (np.einsum("ij,ij->i", n, out) > 1 - 1e-12).all()

@@ -48,7 +48,7 @@ from .bounds import curve_points, patch_points, side_net
 from .bvh import BVH, build_bvh
 from .gauss import SuperSurfaces, grow_super_surfaces, normal_cone, pseudo_gauss_net
 
-__all__ = ["LodModel", "build_lod", "assemble"]
+__all__ = ["LodModel", "build_lod", "assemble", "vertex_normals"]
 
 _CORNER_UV = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 # the corners at the ends of each side (in the side's increasing parameter): side k runs from
@@ -101,6 +101,7 @@ class LodModel:
     meshes: tuple  # [s][l]: (triangles (T, 3) global ids, fan rows (F, 5): tri, edge, a, b, position of c)
     super_edges: tuple  # per super-surface: the edges on its border shared with another super-surface
     simplified: np.ndarray  # (S, L) measured distance added by simplification (0: not simplified)
+    normals: np.ndarray = None  # (V, 3) the surface's unit normal S_u x S_v at every vertex (vertex_normals)
 
     @property
     def levels(self) -> int:
@@ -184,6 +185,9 @@ def _shared_vertices(bs, edges, chains, label, corners):
     n_corner = int(label.max()) + 1 if label.size else 0
     points = [np.zeros((n_corner, 3))]
     points[0][label.ravel()] = corners.reshape(-1, 3)  # one representative per cluster
+    # where each vertex is on the surface, (patch, u, v): for normals
+    first = np.unique(label.ravel(), return_index=True)[1]
+    where = [(first // 4, _CORNER_UV[first % 4])]
     ids, next_id = [], n_corner
     for e, t in enumerate(chains):
         f = int(edges.edge_side[e])
@@ -192,12 +196,16 @@ def _shared_vertices(bs, edges, chains, label, corners):
         inner = curve_points(side_net(bs.control(i), k), t[1:-1])
         ids.append(np.concatenate([[a], next_id + np.arange(t.size - 2), [b]]).astype(np.int64))
         points.append(inner)
+        tt = t[1:-1]
+        uv = np.column_stack([tt, np.zeros_like(tt)] if k == 0 else [np.ones_like(tt), tt] if k == 1 else
+                             [tt, np.ones_like(tt)] if k == 2 else [np.zeros_like(tt), tt])
+        where.append((np.full(tt.size, i), uv))
         next_id += t.size - 2
-    return np.concatenate(points), ids
+    return np.concatenate(points), ids, where
 
 
 def _patch_level(bs, edges, i, level, deltas, chains, births, edge_ids, corner_label, next_id):
-    """One patch at one level: (new interior points, triangles in global ids, next free id)."""
+    """One patch at one level: (new interior points, triangles in global ids, next free id, their (u, v))."""
     side_chain, side_ids = _patch_sides(edges, i, level, chains, births, edge_ids, corner_label)
     tess = adaptive_tessellation(bs.control(i), deltas[level], chains=side_chain)
     return _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id)
@@ -245,7 +253,7 @@ def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id):
     tri = gid[tess.triangles]
     # a triangle with two corners on a pole's side has two vertices that are the one pole vertex: no area
     tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])]
-    return new_points, tri, next_id + inner.size
+    return new_points, tri, next_id + inner.size, uv[inner]
 
 
 def _borders(edges, label, S):
@@ -283,6 +291,41 @@ def _fan_rows(tri, border, edge_ids, births, level):
     return np.concatenate(rows).astype(np.int64)
 
 
+def vertex_normals(bezier, patch, uv) -> np.ndarray:
+    """Unit normals ``S_u x S_v`` of the Bezier patches ``patch (n,)`` at local ``uv (n, 2)``: exact, not
+    averaged from triangles (a vertex shared by patches takes the first patch's; at a G1 or G2 seam they
+    agree). Where ``S_u x S_v`` vanishes (a pole) the normal is taken ``1e-6`` of the domain inside, towards the
+    patch's centre (the limit, to ~1e-6).
+
+    >>> from splinevis.nurbs.exact import sphere
+    >>> from splinevis.nurbs.lod.bezier import bezier_set, evaluate
+    >>> bs = bezier_set(sphere())
+    >>> uv = np.array([[0.0, 0.0], [0.3, 0.6]])  # patch 0's corner (0, 0) is the south pole
+    >>> n = vertex_normals(bs, np.array([0, 0]), uv)
+    >>> (np.round(n, 5) + 0.0).tolist()[0], bool(abs(n[1] @ evaluate(bs, [0], [0.3], [0.6])[0] - 1) < 1e-12)
+    ([0.0, 0.0, -1.0], True)
+    """
+    from .bezier import evaluate
+
+    patch, uv = np.asarray(patch, dtype=np.int64), np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    out = np.zeros((patch.size, 3))
+    if patch.size == 0:
+        return out
+    todo = np.arange(patch.size)
+    for nudge in (0.0, 1e-6, 1e-4):
+        q = uv[todo] + nudge * (0.5 - uv[todo])
+        _, Su, Sv = evaluate(bezier, patch[todo], q[:, 0], q[:, 1], derivatives=True)
+        n = np.cross(Su, Sv)
+        size = np.linalg.norm(n, axis=1)
+        scale = np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1)
+        ok = size > 1e-10 * np.maximum(scale, np.finfo(float).tiny)
+        out[todo[ok]] = n[ok] / size[ok, None]
+        todo = todo[~ok]
+        if todo.size == 0:
+            break
+    return out
+
+
 def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha: float = np.radians(30.0),
               simplify=None, progress: bool = True, workers=None) -> LodModel:
     """Levels of detail of ``model`` (a :class:`~splinevis.nurbs.model.NurbsModel` or one surface) with proven
@@ -310,7 +353,7 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     deltas = float(delta) * float(ratio) ** np.arange(int(levels))
     corner_label, corners = _corner_labels(bs, edges)
     chains, births = _edge_chains(bs, edges, deltas, corner_label)
-    points, edge_ids = _shared_vertices(bs, edges, chains, corner_label, corners)
+    points, edge_ids, where = _shared_vertices(bs, edges, chains, corner_label, corners)
     label = supers.labels
     S = len(supers.members)
     all_points, next_id = [points], points.shape[0]
@@ -345,13 +388,15 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             tris = []
             for i in supers.members[s]:
                 i, _, side_chain, side_ids = jobs[n]
-                new, tri, next_id = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id)
+                new, tri, next_id, uv = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id)
                 n += 1
                 all_points.append(new)
+                where.append((np.full(len(uv), i), uv))
                 tris.append(tri)
             per_level.append(np.concatenate(tris))
         raw.append(per_level)
     vertices = np.concatenate(all_points)
+    normals = vertex_normals(bs, np.concatenate([w[0] for w in where]), np.concatenate([w[1] for w in where]))
     tolerance = deltas.copy()
     simplified = np.zeros((S, deltas.size))
     if simplify is not None:
@@ -369,7 +414,7 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         b = bs.bbox[np.asarray(supers.members[s])]
         boxes[s] = [b[:, 0].min(), b[:, 1].max(), b[:, 2].min(), b[:, 3].max(), b[:, 4].min(), b[:, 5].max()]
     return LodModel(bs, edges, supers, build_bvh(boxes), boxes, tolerance, counts, bs.size, vertices,
-                    tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified)
+                    tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified, normals)
 
 
 def _between(lod, eid, a, b, level):

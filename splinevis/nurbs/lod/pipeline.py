@@ -145,7 +145,7 @@ class Walkthrough:
     assemble : callable, optional
         ``assemble(lod, levels) -> (points, triangles, info)`` (default :func:`.levels.assemble`).
     color : str
-        The mesh colour (flat shading: the mesh has no normals).
+        The mesh colour (shaded with the surface's exact vertex normals, ``LodModel.normals``).
 
     Examples
     --------
@@ -182,6 +182,8 @@ class Walkthrough:
         self._boxes = np.asarray(lod.boxes, dtype=np.float64)
         self.mesh = pv.PolyData(np.zeros((1, 3)))  # replaced by the first mesh (pyvista refuses empty ones)
         self.actor = plotter.add_mesh(self.mesh, color=color, reset_camera=False)
+        if getattr(lod, "normals", None) is not None:  # the surface's exact vertex normals: smooth shading
+            self.actor.prop.interpolation = "phong"
         self._points = None  # the points array the actor shows
         self._shown_cells = None
         self._camera = None  # (frame, eye, view_proj, height)
@@ -254,6 +256,8 @@ class Walkthrough:
             return False
         if record[3] is not self._points:
             self.mesh.points = record[3]
+            if getattr(self.lod, "normals", None) is not None and len(self.lod.normals) == len(record[3]):
+                self.mesh.point_data.active_normals = self.lod.normals  # exact surface normals: smooth shading
             self._points = record[3]
         self.mesh.SetPolys(record[1])
         self.mesh.Modified()

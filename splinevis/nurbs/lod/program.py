@@ -77,6 +77,7 @@ def lod_mesh(model, delta=None, pixel_error=1.0, levels: int = 4, progress: bool
     points, triangles, info = assemble(lod, np.full(len(lod.supers.members), level, dtype=np.int64))
     mesh = pv.PolyData(np.asarray(points, dtype=np.float64),
                        faces=pv.CellArray.from_regular_cells(np.asarray(triangles, dtype=np.int64)))
+    mesh.point_data.active_normals = lod.normals  # the surface's exact normals, not averaged from triangles
     mesh.field_data["lod_level"] = np.array([level])
     mesh.field_data["lod_bound"] = np.array([float(lod.tolerance[level])])
     return mesh
