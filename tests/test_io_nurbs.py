@@ -9,6 +9,7 @@ from math import comb
 import numpy as np
 import pytest
 
+from _occ import occ_bspline_surface
 from splinevis.io.nurbs_files import NURBS_EXTENSIONS, read_nurbs
 from splinevis.io.nurbs_iges import read_iges
 
@@ -237,28 +238,6 @@ def test_3dm_zero_weight_names_file_and_object(tmp_path):
 
 
 # ---- OpenCASCADE: IGES and STEP -------------------------------------------------------------------------
-def occ_bspline_surface():
-    """A rational bicubic x quadratic B-spline surface with an interior knot (OCP Geom_BSplineSurface)."""
-    from OCP.collections import Array1_double, Array1_int, Array2_double, Array2_gp_Pnt
-    from OCP.Geom import Geom_BSplineSurface
-    from OCP.gp import gp_Pnt
-
-    nu, nv = 5, 3
-    poles, weights = Array2_gp_Pnt(1, nu, 1, nv), Array2_double(1, nu, 1, nv)
-    for i in range(nu):
-        for j in range(nv):
-            poles.SetValue(i + 1, j + 1, gp_Pnt(float(i), float(j), round(float(np.sin(i + 2 * j)), 4)))
-            weights.SetValue(i + 1, j + 1, 1.0 + 0.25 * ((i + j) % 3))
-    uk, um, vk, vm = Array1_double(1, 3), Array1_int(1, 3), Array1_double(1, 2), Array1_int(1, 2)
-    for a, (k, m) in enumerate([(0.0, 4), (0.375, 1), (1.0, 4)]):
-        uk.SetValue(a + 1, k)
-        um.SetValue(a + 1, m)
-    for a, (k, m) in enumerate([(0.0, 3), (2.0, 3)]):
-        vk.SetValue(a + 1, k)
-        vm.SetValue(a + 1, m)
-    return Geom_BSplineSurface(poles, weights, uk, vk, um, vm, 3, 2)
-
-
 def occ_shapes():
     """(compound, bspline surface, plate): a B-spline face, a 4 x 2 plate with a hole of radius 1/2 about
     (1, 1) (converted to NURBS), and a free line edge."""

@@ -17,13 +17,12 @@ span that moves the point by ``eps |u| |S_u|``, more than the sums' error, so th
 """
 
 import time
-from itertools import product
 
 import numpy as np
 import pytest
 
 from datasets_synthetic.large_models import hull, hull_spans, teapot_field
-from datasets_synthetic.teapot import TEAPOT_GROUPS, newell_teapot
+from datasets_synthetic.teapot import newell_teapot
 from splinevis.nurbs.exact import cylinder, sphere, torus
 from splinevis.nurbs.hard_cases import trimmed_plate
 from splinevis.nurbs.lod.adjacency import SIDE_NAMES, cluster_points, find_edges, side_curves

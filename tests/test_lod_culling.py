@@ -16,6 +16,8 @@ from splinevis.nurbs.lod.bvh import back_facing, build_bvh, frustum_cull, frustu
 from splinevis.nurbs.lod.gauss import grow_super_surfaces, merge_cones, normal_cone, pseudo_gauss_net, span
 from splinevis.nurbs.operations import bezier_patches, refine_knots
 from splinevis.nurbs.surface import NurbsSurface
+from _camera import look_at as _look_at
+from _camera import perspective as _perspective
 
 
 def _bern(n, t):
@@ -227,22 +229,6 @@ def test_growth_with_the_queue_equals_the_naive_greedy_growth():
 
 
 # ------------------------------------------------------------------------------------------- frustum
-def _perspective(fovy, aspect, near, far):
-    f = 1.0 / np.tan(fovy / 2)
-    return np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],
-                     [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
-
-
-def _look_at(eye, target, up):
-    f = np.asarray(target, float) - eye
-    f /= np.linalg.norm(f)
-    s = np.cross(f, up)
-    s /= np.linalg.norm(s)
-    u = np.cross(s, f)
-    M = np.eye(4)
-    M[0, :3], M[1, :3], M[2, :3] = s, u, -f
-    M[:3, 3] = -M[:3, :3] @ eye
-    return M
 
 
 def _brute_visible(boxes, planes):

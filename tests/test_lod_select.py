@@ -7,30 +7,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from _camera import look_at as _look_at
+from _camera import perspective as _perspective
 from splinevis.nurbs.lod.bvh import back_facing, build_bvh, frustum_planes
 from splinevis.nurbs.lod.select import projection_scale, select_levels
-
-
-def _look_at(eye, focal, up=(0.0, 0.0, 1.0)):
-    eye, focal, up = (np.asarray(v, dtype=np.float64) for v in (eye, focal, up))
-    f = focal - eye
-    f /= np.linalg.norm(f)
-    s = np.cross(f, up)
-    s /= np.linalg.norm(s)
-    u = np.cross(s, f)
-    V = np.eye(4)
-    V[0, :3], V[1, :3], V[2, :3] = s, u, -f
-    V[:3, 3] = -V[:3, :3] @ eye
-    return V
-
-
-def _perspective(fov_y, aspect, near, far):
-    t = 1.0 / math.tan(0.5 * fov_y)
-    P = np.zeros((4, 4))
-    P[0, 0], P[1, 1] = t / aspect, t
-    P[2, 2], P[2, 3] = -(far + near) / (far - near), -2.0 * far * near / (far - near)
-    P[3, 2] = -1.0
-    return P
 
 
 def _ortho(half_height, aspect, near, far):

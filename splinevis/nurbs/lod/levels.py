@@ -41,7 +41,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from .adaptive import _check_chains, _curve_chains, _tessellate, adaptive_tessellation, curve_chain
+from .adaptive import _check_chains, _curve_chains, _tessellate, curve_chain
 from .adjacency import Edges, cluster_points, find_edges
 from .bezier import BezierSet, bezier_set
 from .bounds import curve_points, patch_points, side_net
@@ -202,13 +202,6 @@ def _shared_vertices(bs, edges, chains, label, corners):
         where.append((np.full(tt.size, i), uv))
         next_id += t.size - 2
     return np.concatenate(points), ids, where
-
-
-def _patch_level(bs, edges, i, level, deltas, chains, births, edge_ids, corner_label, next_id):
-    """One patch at one level: (new interior points, triangles in global ids, next free id, their (u, v))."""
-    side_chain, side_ids = _patch_sides(edges, i, level, chains, births, edge_ids, corner_label)
-    tess = adaptive_tessellation(bs.control(i), deltas[level], chains=side_chain)
-    return _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id)
 
 
 def _patch_sides(edges, i, level, chains, births, edge_ids, corner_label):
