@@ -102,6 +102,10 @@ class LodModel:
     super_edges: tuple  # per super-surface: the edges on its border shared with another super-surface
     simplified: np.ndarray  # (S, L) measured distance added by simplification (0: not simplified)
     normals: np.ndarray = None  # (V, 3) the surface's unit normal S_u x S_v at every vertex (vertex_normals)
+    delta_trim: float = 0.0  # the share of each level's bound taken by the trim polylines (0: no trims)
+    vertex_patch: np.ndarray = None  # (V,) a Bezier patch each vertex lies on (a shared one: the edge's first side)
+    vertex_uv: np.ndarray = None  # (V, 2) its local parameters there
+    status: np.ndarray = None  # (P,) per Bezier patch: 0 untrimmed or inside its trims, 1 clipped, -1 trimmed away
 
     @property
     def levels(self) -> int:
@@ -320,13 +324,14 @@ def vertex_normals(bezier, patch, uv) -> np.ndarray:
 
 
 def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha: float = np.radians(30.0),
-              simplify=None, progress: bool = True, workers=None) -> LodModel:
+              simplify=None, progress: bool = True, workers=None, trim_share: float = 0.125) -> LodModel:
     """Levels of detail of ``model`` (a :class:`~splinevis.nurbs.model.NurbsModel` or one surface) with proven
     bounds ``delta * ratio**l``, ``l = 0..levels-1`` (module docstring). With ``simplify`` (a
     :class:`~splinevis.nurbs.lod.simplify.Simplifier`) the levels ``l > 0`` are decimated across patch edges
-    and held to ``delta_l + eps_l`` by measurement. Trim loops are not applied yet: a trimmed patch is
-    tessellated whole. ``workers`` processes tessellate batches of patches (None: ``os.cpu_count()``; 1: in
-    this process); the result is the same for any number.
+    and held to ``delta_l + eps_l`` by measurement. Trim loops are applied (:mod:`.trims`): in a model with trims
+    the share ``trim_share`` of ``delta`` goes to the trim polylines and ``delta_l - trim_share * delta`` to the
+    triangles, so each level keeps ``delta_l`` with its trims. ``workers`` processes tessellate batches of
+    patches (None: ``os.cpu_count()``; 1: in this process); the result is the same for any number.
 
     >>> from splinevis.nurbs.exact import torus
     >>> lod = build_lod(torus(), 0.02, levels=3, progress=False)
@@ -344,8 +349,23 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     axis, half = _patch_cones(bs)
     supers = grow_super_surfaces((axis, half), _neighbours(edges), float(alpha))
     deltas = float(delta) * float(ratio) ** np.arange(int(levels))
+    trimmed = bool(bs.trimmed.any())
+    if trimmed and not 0.0 < float(trim_share) < 1.0:
+        raise ValueError(f"trim_share must lie in (0, 1), got {trim_share!r}.")
+    delta_trim = float(trim_share) * float(delta) if trimmed else 0.0
     corner_label, corners = _corner_labels(bs, edges)
-    chains, births = _edge_chains(bs, edges, deltas, corner_label)
+    chains, births = _edge_chains(bs, edges, deltas - delta_trim, corner_label)
+    status = np.zeros(len(bs), dtype=np.int64)
+    if trimmed:
+        from .trims import merge_params, trim_plan
+
+        plan = trim_plan(bs, edges, model.trims, delta_trim)
+        status = plan.status
+        for e, extra in plan.edge_params.items():  # trim crossings: in every level's chain of the edge
+            t, new = merge_params(chains[e], extra)
+            b = np.full(t.size, deltas.size - 1, dtype=np.int64)
+            b[~new] = births[e]
+            chains[e], births[e] = t, b
     points, edge_ids, where = _shared_vertices(bs, edges, chains, corner_label, corners)
     label = supers.labels
     S = len(supers.members)
@@ -354,8 +374,9 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     border = _borders(edges, label, S)
     # every patch at every level, tessellated in batches of one degree (lockstep refinement: bitwise the
     # results of one adaptive_tessellation call each), then numbered in the order super-surface, level, patch
-    jobs = [(int(i), level) + _patch_sides(edges, int(i), level, chains, births, edge_ids, corner_label)
-            for s in range(S) for level in range(deltas.size) for i in supers.members[s]]
+    drawn = [[int(i) for i in supers.members[s] if status[i] >= 0] for s in range(S)]  # not wholly trimmed away
+    jobs = [(i, level) + _patch_sides(edges, i, level, chains, births, edge_ids, corner_label)
+            for s in range(S) for level in range(deltas.size) for i in drawn[s]]
     by_degree: dict = {}
     for n, (i, level, side_chain, _) in enumerate(jobs):
         by_degree.setdefault(int(bs.group[i]), []).append(n)
@@ -365,8 +386,8 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         workers = 1  # not worth starting processes
     size = max(64, min(_BATCH, -(-len(jobs) // (2 * workers))))
     parts = [group[a:a + size] for group in by_degree.values() for a in range(0, len(group), size)]
-    batches = ([(bs.control(jobs[n][0]), float(deltas[jobs[n][1]]), _check_chains(jobs[n][2])) for n in part]
-               for part in parts)
+    batches = ([(bs.control(jobs[n][0]), float(deltas[jobs[n][1]] - delta_trim), _check_chains(jobs[n][2]))
+                for n in part] for part in parts)
     bar = tqdm(total=len(jobs), desc="lod: tessellation", disable=not progress, unit="patch")
     with (ProcessPoolExecutor(workers) if workers > 1 else contextlib.nullcontext()) as pool:
         for part, got in zip(parts, pool.map(_tessellate, batches) if pool else map(_tessellate, batches)):
@@ -374,22 +395,31 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
                 tess[n] = t
             bar.update(len(part))
     bar.close()
+    if trimmed:
+        from .trims import clip_patch
+
+        for n, (i, level, side_chain, _) in enumerate(jobs):
+            if status[i] == 1:
+                tess[n] = clip_patch(bs.control(i), plan.local[i], side_chain, float(deltas[level] - delta_trim),
+                                     tess[n])
     raw, n = [], 0
     for s in range(S):
         per_level = []
         for level in range(deltas.size):
             tris = []
-            for i in supers.members[s]:
+            for _ in drawn[s]:
                 i, _, side_chain, side_ids = jobs[n]
                 new, tri, next_id, uv = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id)
                 n += 1
                 all_points.append(new)
                 where.append((np.full(len(uv), i), uv))
                 tris.append(tri)
-            per_level.append(np.concatenate(tris))
+            per_level.append(np.concatenate(tris) if tris else np.zeros((0, 3), dtype=np.int64))
         raw.append(per_level)
     vertices = np.concatenate(all_points)
-    normals = vertex_normals(bs, np.concatenate([w[0] for w in where]), np.concatenate([w[1] for w in where]))
+    vertex_patch = np.concatenate([w[0] for w in where]).astype(np.int64)
+    vertex_uv = np.concatenate([w[1] for w in where])
+    normals = vertex_normals(bs, vertex_patch, vertex_uv)
     tolerance = deltas.copy()
     simplified = np.zeros((S, deltas.size))
     if simplify is not None:
@@ -407,7 +437,8 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         b = bs.bbox[np.asarray(supers.members[s])]
         boxes[s] = [b[:, 0].min(), b[:, 1].max(), b[:, 2].min(), b[:, 3].max(), b[:, 4].min(), b[:, 5].max()]
     return LodModel(bs, edges, supers, build_bvh(boxes), boxes, tolerance, counts, bs.size, vertices,
-                    tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified, normals)
+                    tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified, normals,
+                    delta_trim=delta_trim, status=status, vertex_patch=vertex_patch, vertex_uv=vertex_uv)
 
 
 def _between(lod, eid, a, b, level):
