@@ -435,6 +435,8 @@ def _loop(wire, face, path, name: str) -> list:
         bs = Geom2dConvert.CurveToBSplineCurve_s(Geom2d_TrimmedCurve(curve, a, b))
         if bs.IsPeriodic():
             bs.SetNotPeriodic()
+        if bs.Degree() > 3:  # intersection pcurves come as degree 8 and more: a cubic within 1e-9 of the domain
+            bs = _cubic_pcurve(bs, path, name)
         if edge.Orientation() == TopAbs_REVERSED:
             bs.Reverse()
         n = bs.NbPoles()
@@ -443,3 +445,20 @@ def _loop(wire, face, path, name: str) -> list:
         w = [bs.Weight(i) for i in range(1, n + 1)] if bs.IsRational() else None
         loop.append(checked(path, f"{name} trim curve", lambda: TrimCurve(bs.Degree(), knots, pts, w)))
     return loop
+
+
+def _cubic_pcurve(bs, path, name):
+    """A C1 cubic B-spline within ``1e-9`` of the domain's size of the pcurve ``bs`` (OpenCASCADE's
+    ``Geom2dConvert_ApproxCurve``): the trims of the per-fragment program are cubic at most, and the files'
+    intersection curves come as degree 8 and more."""
+    from OCP.Geom2dConvert import Geom2dConvert_ApproxCurve
+    from OCP.GeomAbs import GeomAbs_C1
+
+    box = [bs.Pole(i) for i in range(1, bs.NbPoles() + 1)]
+    size = max(max(p.X() for p in box) - min(p.X() for p in box), max(p.Y() for p in box) - min(p.Y() for p in box))
+    tol = 1e-9 * max(size, 1e-300)
+    approx = Geom2dConvert_ApproxCurve(bs, tol, GeomAbs_C1, 1000, 3)  # C2 would need degree 5 here
+    if not (approx.IsDone() and approx.HasResult()) or approx.MaxError() > tol:
+        raise ValueError(f"{path}: {name}: a trim curve of degree {bs.Degree()} could not be brought to a cubic "
+                         f"within {tol:.3g} (OpenCASCADE's approximation reached {approx.MaxError():.3g}).")
+    return approx.Curve()

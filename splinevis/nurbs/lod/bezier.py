@@ -27,7 +27,7 @@ from ..model import NurbsModel
 from ..operations import bezier_segments
 from ..surface import NurbsSurface
 
-__all__ = ["BezierGroup", "BezierSet", "bezier_set", "evaluate", "bernstein"]
+__all__ = ["BezierGroup", "BezierSet", "bezier_set", "evaluate", "bernstein", "locate"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -353,3 +353,28 @@ def _evaluate_group(C, rows, u, v, derivatives):
             Su[a:b] = (Au[:, :3] - Au[:, 3:] * S[a:b]) / w
             Sv[a:b] = (Av[:, :3] - Av[:, 3:] * S[a:b]) / w
     return (S, Su, Sv) if derivatives else S
+
+
+def locate(bs, f: int, uv) -> tuple:
+    """The patch and local parameters ``(patch (K,), st (K, 2))`` of the points ``uv (K, 2)`` of surface ``f``'s
+    domain (a point on a knot line: the first patch whose closed rectangle holds it; outside every one: the
+    nearest, clamped).
+
+    >>> from splinevis.nurbs.exact import torus
+    >>> p, st = locate(bezier_set(torus()), 0, [[0.3, 0.6]])  # 4 x 4 spans of 1/4
+    >>> p.tolist(), st.round(6).tolist()
+    ([6], [[0.2, 0.4]])
+    """
+    ids = np.flatnonzero(bs.parent == f)
+    r = bs.rect[ids]
+    uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    inside = ((uv[:, None, 0] >= r[None, :, 0]) & (uv[:, None, 0] <= r[None, :, 1])
+              & (uv[:, None, 1] >= r[None, :, 2]) & (uv[:, None, 1] <= r[None, :, 3]))
+    # outside every rectangle (rounding at the border): the nearest
+    gap = (np.maximum(0, r[None, :, 0] - uv[:, None, 0]) + np.maximum(0, uv[:, None, 0] - r[None, :, 1])
+           + np.maximum(0, r[None, :, 2] - uv[:, None, 1]) + np.maximum(0, uv[:, None, 1] - r[None, :, 3]))
+    k = np.where(inside.any(axis=1), np.argmax(inside, axis=1), np.argmin(gap, axis=1))
+    p, rr = ids[k], r[k]
+    s = np.clip((uv[:, 0] - rr[:, 0]) / (rr[:, 1] - rr[:, 0]), 0.0, 1.0)
+    t = np.clip((uv[:, 1] - rr[:, 2]) / (rr[:, 3] - rr[:, 2]), 0.0, 1.0)
+    return p, np.column_stack([s, t])

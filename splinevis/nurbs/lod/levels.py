@@ -226,11 +226,13 @@ def _patch_sides(edges, i, level, chains, births, edge_ids, corner_label):
     return side_chain, side_ids
 
 
-def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id):
-    """The tessellation ``tess`` of patch ``i`` in global ids: (new interior points, triangles, next free id)."""
+def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id, fixed=None, joins=None):
+    """The tessellation ``tess`` of patch ``i`` in global ids: (new interior points, triangles, next free id).
+    ``fixed``: a global id for some vertices (stitched trim vertices, :mod:`.stitch`), -1 elsewhere; where such a
+    vertex lies on a side, the pair (its id, the chain vertex's id) is appended to ``joins``."""
     Pw = bs.control(i)
     uv = tess.uv
-    gid = np.full(uv.shape[0], -1, dtype=np.int64)
+    gid = np.full(uv.shape[0], -1, dtype=np.int64) if fixed is None else np.array(fixed, dtype=np.int64)
     on_side = ((uv[:, 1] == 0.0), (uv[:, 0] == 1.0), (uv[:, 1] == 1.0), (uv[:, 0] == 0.0))
     along = (uv[:, 0], uv[:, 1], uv[:, 0], uv[:, 1])
     for k in range(4):
@@ -244,6 +246,9 @@ def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id):
             raise RuntimeError(f"patch {i} side {k}: a boundary vertex off its chain (the tessellation must keep "
                                "given chains exactly)")
         gid[rows] = side_ids[k][pos]
+    if fixed is not None:  # a stitched trim vertex on a side (a knot-line crossing) is that side's chain vertex
+        both = np.flatnonzero((np.asarray(fixed) >= 0) & (gid != np.asarray(fixed)))
+        joins.extend(zip(np.asarray(fixed)[both].tolist(), gid[both].tolist()))
     inner = np.flatnonzero(gid < 0)
     gid[inner] = next_id + np.arange(inner.size)
     new_points = patch_points(Pw, uv[inner]) if inner.size else np.zeros((0, 3))
@@ -324,13 +329,16 @@ def vertex_normals(bezier, patch, uv) -> np.ndarray:
 
 
 def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha: float = np.radians(30.0),
-              simplify=None, progress: bool = True, workers=None, trim_share: float = 0.125) -> LodModel:
+              simplify=None, progress: bool = True, workers=None, trim_share: float = 0.125,
+              tol=None) -> LodModel:
     """Levels of detail of ``model`` (a :class:`~splinevis.nurbs.model.NurbsModel` or one surface) with proven
     bounds ``delta * ratio**l``, ``l = 0..levels-1`` (module docstring). With ``simplify`` (a
     :class:`~splinevis.nurbs.lod.simplify.Simplifier`) the levels ``l > 0`` are decimated across patch edges
     and held to ``delta_l + eps_l`` by measurement. Trim loops are applied (:mod:`.trims`): in a model with trims
     the share ``trim_share`` of ``delta`` goes to the trim polylines and ``delta_l - trim_share * delta`` to the
-    triangles, so each level keeps ``delta_l`` with its trims. ``workers`` processes tessellate batches of
+    triangles, so each level keeps ``delta_l`` with its trims; surfaces meeting along trim curves share their
+    border vertices (:mod:`.stitch`; ``tol``: the model's tolerance, default ``1e-6`` of its size, added to the
+    bound where stitched vertices move). ``workers`` processes tessellate batches of
     patches (None: ``os.cpu_count()``; 1: in this process); the result is the same for any number.
 
     >>> from splinevis.nurbs.exact import torus
@@ -352,14 +360,19 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     trimmed = bool(bs.trimmed.any())
     if trimmed and not 0.0 < float(trim_share) < 1.0:
         raise ValueError(f"trim_share must lie in (0, 1), got {trim_share!r}.")
+    tol = 1e-6 * bs.size if tol is None else float(tol)
     delta_trim = float(trim_share) * float(delta) if trimmed else 0.0
     corner_label, corners = _corner_labels(bs, edges)
     chains, births = _edge_chains(bs, edges, deltas - delta_trim, corner_label)
     status = np.zeros(len(bs), dtype=np.int64)
     if trimmed:
-        from .trims import merge_params, trim_plan
+        from .stitch import stitch_borders, update_chains
+        from .trims import face_rings, merge_params, trim_plan
 
-        plan = trim_plan(bs, edges, model.trims, delta_trim)
+        rings = face_rings(bs, model.trims, delta_trim, chord=0.5 * float(deltas[0] - delta_trim))
+        stitch = stitch_borders(bs, edges, rings, chains, float(deltas[0]), tol)
+        update_chains(stitch, chains, births, deltas.size)
+        plan = trim_plan(bs, edges, stitch.rings, delta_trim)
         status = plan.status
         for e, extra in plan.edge_params.items():  # trim crossings: in every level's chain of the edge
             t, new = merge_params(chains[e], extra)
@@ -367,6 +380,12 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             b[~new] = births[e]
             chains[e], births[e] = t, b
     points, edge_ids, where = _shared_vertices(bs, edges, chains, corner_label, corners)
+    if trimmed:  # stitched trim vertices: an edge's vertex, or one new vertex per class
+        from .stitch import fixed_ids, resolve
+
+        node_gid, joined, joined_patch, joined_uv = resolve(stitch, chains, edge_ids, points.shape[0])
+        points = np.concatenate([points, joined])
+        where.append((joined_patch, joined_uv))
     label = supers.labels
     S = len(supers.members)
     all_points, next_id = [points], points.shape[0]
@@ -396,20 +415,24 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             bar.update(len(part))
     bar.close()
     if trimmed:
-        from .trims import clip_patch
+        from .clip import clip_patch
+        from .trims import local_rings
 
         for n, (i, level, side_chain, _) in enumerate(jobs):
             if status[i] == 1:
                 tess[n] = clip_patch(bs.control(i), plan.local[i], side_chain, float(deltas[level] - delta_trim),
-                                     tess[n])
-    raw, n = [], 0
+                                     tess[n], local_rings(stitch.rings[int(bs.parent[i])][0], bs.rect[i]))
+    raw, n, joins = [], 0, []
     for s in range(S):
         per_level = []
         for level in range(deltas.size):
             tris = []
             for _ in drawn[s]:
                 i, _, side_chain, side_ids = jobs[n]
-                new, tri, next_id, uv = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id)
+                fixed = (fixed_ids(stitch, node_gid, bs.rect[i], int(bs.parent[i]), tess[n].uv)
+                         if trimmed and status[i] == 1 else None)
+                new, tri, next_id, uv = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id, fixed,
+                                                      joins)
                 n += 1
                 all_points.append(new)
                 where.append((np.full(len(uv), i), uv))
@@ -417,6 +440,11 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             per_level.append(np.concatenate(tris) if tris else np.zeros((0, 3), dtype=np.int64))
         raw.append(per_level)
     vertices = np.concatenate(all_points)
+    if joins:  # stitched vertices that are chain vertices of their own surface: one vertex, the chain's
+        remap = np.arange(vertices.shape[0])
+        for a, b in joins:
+            remap[a] = b
+        raw = [[remap[t] for t in per_level] for per_level in raw]
     vertex_patch = np.concatenate([w[0] for w in where]).astype(np.int64)
     vertex_uv = np.concatenate([w[1] for w in where])
     normals = vertex_normals(bs, vertex_patch, vertex_uv)

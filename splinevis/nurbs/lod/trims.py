@@ -31,10 +31,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .adaptive import Tessellation, _curve_chains
-from .bounds import _curve_points_rows, patch_points, triangle_bounds
+from .adaptive import _curve_chains
+from .bounds import _curve_points_rows
 
-__all__ = ["TrimPlan", "trim_plan", "gradient_bound", "trim_polylines", "merge_params", "clip_tessellation", "clip_patch"]
+__all__ = ["TrimPlan", "face_rings", "split_segments", "trim_plan", "gradient_bound", "trim_polylines", "merge_params", "local_rings"]
 
 _WELD = 1e-11  # local-domain distance under which two computed points are one vertex (rounding of intersections)
 
@@ -103,8 +103,8 @@ def trim_polylines(loops, h: float) -> list:
                 params[k] = t
         for s, t in zip(segs, params):
             C = np.column_stack([s[:, :2], s[:, 2]])
-            pts.append(_curve_points_rows(np.repeat(C[None], t.size - 1, axis=0), t[:-1]))
-        ring = np.concatenate(pts)
+            pts.append(_curve_points_rows(np.repeat(C[None], t.size, axis=0), t))  # end points included
+        ring = _chain_pieces(pts)
         keep = np.ones(len(ring), dtype=bool)
         keep[1:] = np.linalg.norm(np.diff(ring, axis=0), axis=1) > 0
         out.append(ring[keep])
@@ -119,6 +119,22 @@ def _polygonal(geom):
     parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))] if parts.size else parts
     parts = parts[shapely.area(parts) > 0] if parts.size else parts
     return shapely.union_all(parts) if parts.size else shapely.Polygon()
+
+
+def _chain_pieces(pieces):
+    """One closed polyline from polyline pieces given in any order and direction (files list a loop's edges
+    so, e.g. OpenCASCADE's wires of a seam face): each next piece is the one with an end nearest the current
+    end, reversed if need be; the joints' duplicate points are dropped."""
+    todo = [np.asarray(p, dtype=np.float64) for p in pieces]
+    ring = [todo.pop(0)]
+    while todo:
+        end = ring[-1][-1]
+        d0 = [float(np.linalg.norm(p[0] - end)) for p in todo]
+        d1 = [float(np.linalg.norm(p[-1] - end)) for p in todo]
+        k0, k1 = int(np.argmin(d0)), int(np.argmin(d1))
+        ring.append(todo.pop(k0) if d0[k0] <= d1[k1] else todo.pop(k1)[::-1])
+    out = np.concatenate([r[:-1] for r in ring])  # each piece's last point is the next one's first
+    return out
 
 
 def _region(rings):
@@ -154,9 +170,98 @@ class TrimPlan(NamedTuple):
 _SIDE_LINES = (((0.0, 0.0), (1.0, 0.0)), ((1.0, 0.0), (1.0, 1.0)), ((0.0, 1.0), (1.0, 1.0)), ((0.0, 0.0), (0.0, 1.0)))
 
 
-def trim_plan(bs, edges, trims, delta_trim: float) -> TrimPlan:
-    """The trim polylines of every trimmed surface at ``delta_trim`` and what they do to each Bezier patch of
-    ``bs`` (module docstring). ``trims``: the model's per-surface loops (None: untrimmed).
+def face_rings(bs, trims, delta_trim: float, chord=None) -> dict:
+    """Per trimmed surface ``f`` of the model: ``(rings, h)``, its trim loops as closed polylines in its parameter
+    domain (:func:`trim_polylines`) with the domain tolerance ``h = delta_trim / Lip``, ``Lip`` the largest
+    :func:`gradient_bound` of its patches. The polylines hold every point where they cross a knot line, and with
+    ``chord`` their segments are halved until the surface over each deviates from its chord by at most ``chord``
+    (:func:`split_segments`): a polyline edge is a mesh edge, and a long one over a curved surface could not be.
+
+    >>> from splinevis.nurbs.exact import saddle, CIRCLE_KNOTS, circle_net
+    >>> from splinevis.nurbs.model import NurbsModel, TrimCurve
+    >>> from splinevis.nurbs.lod.bezier import bezier_set
+    >>> xy, w = circle_net()
+    >>> m = NurbsModel([saddle()], trims=[[[TrimCurve(2, CIRCLE_KNOTS, 0.5 + 0.25 * xy, w)]]])
+    >>> rings, h = face_rings(bezier_set(m), m.trims, 1e-3)[0]
+    >>> len(rings), round(h, 8)  # Lip = 2 sqrt(10): the saddle's net over [0, 1]^2
+    (1, 0.00015811)
+    """
+    out = {}
+    parents = np.unique(bs.parent[bs.trimmed]) if bs.trimmed.any() else np.zeros(0, dtype=np.int64)
+    for f in parents:
+        ids = np.flatnonzero(bs.parent == f)
+        lip = max(gradient_bound(bs.control(int(i)), bs.rect[i]) for i in ids)
+        h = float(delta_trim) / max(lip, np.finfo(float).tiny)
+        rings = [split_segments(bs, int(f), r, chord) for r in trim_polylines(trims[int(f)], h)]
+        out[int(f)] = (rings, h)
+    return out
+
+
+def split_segments(bs, f: int, ring, chord=None, rounds: int = 40):
+    """The closed polyline ``ring`` of surface ``f``'s domain with the points where it crosses the patches' knot
+    lines put in (exactly on them), then, with ``chord``, each segment halved while the proven bound of
+    ``|F - L|`` on a triangle having the segment as a side (:func:`splinevis.nurbs.lod.bounds.triangle_bounds`;
+    on that side ``L`` is the chord) exceeds ``chord``. The polyline's shape is unchanged (points on its
+    segments).
+
+    >>> from splinevis.nurbs.exact import saddle
+    >>> from splinevis.nurbs.lod.bezier import bezier_set
+    >>> line = np.array([[0.6, 0.0], [0.6, 1.0], [0.0, 1.0], [0.0, 0.0]])
+    >>> r = split_segments(bezier_set(saddle()), 0, line, chord=0.01)
+    >>> r.shape[0] > 20, bool(np.isin(line, r).all(axis=1).all())
+    (True, True)
+    """
+    from .bounds import triangle_bounds
+
+    ids = np.flatnonzero(bs.parent == f)
+    rect = bs.rect[ids]
+    ku, kv = np.unique(rect[:, :2]), np.unique(rect[:, 2:])
+    ring = np.asarray(ring, dtype=np.float64)
+    pts = []
+    for a, b in zip(ring, np.roll(ring, -1, axis=0)):  # knot-line crossings, exact on the lines
+        pts.append(a[None])
+        cuts = []
+        for axis, knots in ((0, ku), (1, kv)):
+            lo, hi = min(a[axis], b[axis]), max(a[axis], b[axis])
+            for k in knots[(knots > lo) & (knots < hi)]:
+                s = (k - a[axis]) / (b[axis] - a[axis])
+                q = a + s * (b - a)
+                q[axis] = k
+                cuts.append((s, q))
+        pts.extend(q[None] for _, q in sorted(cuts, key=lambda c: c[0]))
+    ring = np.concatenate(pts)
+    if chord is None:
+        return ring
+    from .bezier import locate as _locate
+
+    for _ in range(int(rounds)):
+        a, b = ring, np.roll(ring, -1, axis=0)
+        p, st = _locate(bs, f, 0.5 * (a + b))
+        r = bs.rect[p]
+        la = np.column_stack([(a[:, 0] - r[:, 0]) / (r[:, 1] - r[:, 0]), (a[:, 1] - r[:, 2]) / (r[:, 3] - r[:, 2])])
+        lb = np.column_stack([(b[:, 0] - r[:, 0]) / (r[:, 1] - r[:, 0]), (b[:, 1] - r[:, 2]) / (r[:, 3] - r[:, 2])])
+        d = lb - la
+        n = np.column_stack([-d[:, 1], d[:, 0]])
+        n *= np.where(np.einsum("ki,ki->k", n, 0.5 - st) < 0, -0.5, 0.5)[:, None]
+        c = np.clip(st + n, 0.0, 1.0)
+        Pw = np.stack([bs.control(int(i)) for i in p])
+        bound = triangle_bounds(Pw, np.stack([la, lb, c], axis=1))
+        split = bound > float(chord)
+        if not split.any():
+            break
+        mids = 0.5 * (a + b)
+        out = np.empty((ring.shape[0] + int(split.sum()), 2))
+        pos = np.arange(ring.shape[0]) + np.concatenate([[0], np.cumsum(split)[:-1]])
+        out[pos] = ring
+        out[pos[split] + 1] = mids[split]
+        ring = out
+    return ring
+
+
+def trim_plan(bs, edges, rings: dict, delta_trim: float) -> TrimPlan:
+    """What the trim polylines ``rings`` (:func:`face_rings`) do to each Bezier patch of ``bs`` (module
+    docstring): wholly inside, crossed (its region in its local domain, and where the polylines cross its sides,
+    as parameters along the edges), or wholly outside.
 
     >>> from splinevis.nurbs.exact import saddle, CIRCLE_KNOTS, circle_net
     >>> from splinevis.nurbs.model import NurbsModel, TrimCurve
@@ -167,9 +272,9 @@ def trim_plan(bs, edges, trims, delta_trim: float) -> TrimPlan:
     ...                                                         ((1, 1), (0, 1)), ((0, 1), (0, 0))]]
     >>> m = NurbsModel([saddle()], trims=[[border, [TrimCurve(2, CIRCLE_KNOTS, 0.5 + 0.25 * xy, w)]]])
     >>> bs = bezier_set(m)
-    >>> plan = trim_plan(bs, find_edges(bs), m.trims, 1e-3)
-    >>> plan.status.tolist(), plan.edge_params
-    ([1], {})
+    >>> plan = trim_plan(bs, find_edges(bs), face_rings(bs, m.trims, 1e-3), 1e-3)
+    >>> plan.status.tolist(), plan.edge_params, round(plan.local[0].area, 4)  # 1 - pi / 16
+    ([1], {}, 0.8037)
     """
     import shapely
 
@@ -177,17 +282,10 @@ def trim_plan(bs, edges, trims, delta_trim: float) -> TrimPlan:
     status = np.zeros(P, dtype=np.int64)
     local: list = [None] * P
     edge_params: dict = {}
-    hs: dict = {}
-    parents = np.unique(bs.parent[bs.trimmed]) if bs.trimmed.any() else np.zeros(0, dtype=np.int64)
-    for f in parents:
-        loops = trims[int(f)]
-        ids = np.flatnonzero(bs.parent == f)
-        lip = max(gradient_bound(bs.control(int(i)), bs.rect[i]) for i in ids)
-        h = float(delta_trim) / max(lip, np.finfo(float).tiny)
-        hs[int(f)] = h
-        region = _region(trim_polylines(loops, h))
+    for f, (face, h) in rings.items():
+        region = _region(face)
         shapely.prepare(region)
-        for i in ids:
+        for i in np.flatnonzero(bs.parent == f):
             u0, u1, v0, v1 = bs.rect[i]
             rect = shapely.box(u0, v0, u1, v1)
             if region.contains(rect):
@@ -206,17 +304,15 @@ def trim_plan(bs, edges, trims, delta_trim: float) -> TrimPlan:
                 e = int(edges.side_edge[i, k])
                 if e < 0:
                     continue
-                hit = shapely.intersection(lb, shapely.LineString([a, b]))
-                pts = shapely.get_coordinates(hit)
-                run = 0 if k in (0, 2) else 1
-                t = pts[:, run] if pts.size else np.zeros(0)
+                pts = shapely.get_coordinates(shapely.intersection(lb, shapely.LineString([a, b])))
+                t = pts[:, 0 if k in (0, 2) else 1] if pts.size else np.zeros(0)
                 t = t[(t > _WELD) & (t < 1.0 - _WELD)]
                 if t.size:
                     if edges.side_reversed[i, k]:
                         t = 1.0 - t
                     edge_params.setdefault(e, []).extend(t.tolist())
     edge_params = {e: np.unique(np.asarray(v)) for e, v in edge_params.items()}
-    return TrimPlan(status, local, edge_params, float(delta_trim), hs)
+    return TrimPlan(status, local, edge_params, float(delta_trim), {f: h for f, (_, h) in rings.items()})
 
 
 def _affine(geom, A):
@@ -244,172 +340,11 @@ def merge_params(t, extra):
     return merged[order], new[order]
 
 
-def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float) -> Tessellation:
-    """The tessellation ``tess`` of a patch (local domain) clipped to ``region`` (shapely, local domain): triangles
-    the region's boundary meets are intersected with it and triangulated, their vertices on the patch's sides
-    snapped to the side ``chains`` (4 sorted parameter arrays, as the patch sees them; a side vertex off its chain
-    raises), T-junctions fanned. ``bound`` is each triangle's proven bound; ``converged`` is False when a piece's
-    bound exceeds both ``target`` and the bound of the triangle it was cut from.
+def local_rings(rings, rect) -> list:
+    """Polylines ``rings`` of a surface's domain in the local domain of the patch with ``rect`` (u0, u1, v0, v1).
 
-    >>> import shapely
-    >>> from splinevis.nurbs.exact import saddle
-    >>> from splinevis.nurbs.lod.bezier import bezier_set
-    >>> from splinevis.nurbs.lod.adaptive import adaptive_tessellation
-    >>> Pw = bezier_set(saddle()).control(0)
-    >>> t = adaptive_tessellation(Pw, 0.05)
-    >>> hole = shapely.box(0, 0, 1, 1).difference(shapely.Point(0.5, 0.5).buffer(0.2, 64))
-    >>> c = clip_tessellation(t, Pw, hole, [[0.0, 1.0]] * 4, 0.05)
-    >>> cen = c.uv[c.triangles].mean(axis=1)
-    >>> bool((np.linalg.norm(cen - 0.5, axis=1) > 0.19).all()), c.converged, bool(c.bound.max() <= 0.05)
-    (True, True, True)
+    >>> local_rings([np.array([[1.0, 2.0], [3.0, 2.0]])], (1.0, 3.0, 2.0, 4.0))[0].tolist()
+    [[0.0, 0.0], [1.0, 0.0]]
     """
-    import shapely
-
-    uv, tri = tess.uv, tess.triangles
-    polys = shapely.polygons(np.concatenate([uv[tri], uv[tri][:, :1]], axis=1))
-    shapely.prepare(region)
-    meets = shapely.intersects(polys, region.boundary)
-    keep_whole = np.flatnonzero(~meets & shapely.intersects(polys, region))  # wholly inside
-    cut = np.flatnonzero(meets)
-    tris, parent = shapely.get_parts(shapely.constrained_delaunay_triangles(shapely.intersection(polys[cut], region)),
-                                     return_index=True)
-    ok = (shapely.get_type_id(tris) == 3) & (shapely.area(tris) > 0) if tris.size else np.zeros(0, dtype=bool)
-    tris, parent = tris[ok], cut[parent[ok]]
-    coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3] if tris.size else np.zeros((0, 3, 2))
-    P, index = _weld(uv, coords.reshape(-1, 2), chains)
-    piece = index.reshape(-1, 3)
-    allowed = np.maximum(float(target), tess.bound)  # what each triangle of tess was accepted with
-    all_tri = np.concatenate([tri[keep_whole], piece])
-    origin = np.concatenate([keep_whole, parent])
-    A = _signed_area(P[all_tri])
-    all_tri, origin, A = all_tri[A != 0.0], origin[A != 0.0], A[A != 0.0]
-    all_tri[A < 0] = all_tri[A < 0][:, ::-1]
-    all_tri, origin = _fan_t_junctions(P, all_tri, origin, np.unique(piece))
-    used = np.unique(all_tri)
-    remap = np.full(P.shape[0], -1, dtype=np.int64)
-    remap[used] = np.arange(used.size)
-    out_uv, out_tri = P[used], remap[all_tri]
-    X = patch_points(Pw, out_uv)
-    bound = triangle_bounds(Pw, out_uv[out_tri], X[out_tri]) if out_tri.size else np.zeros(0)
-    # a piece that is its whole triangle (listed in another vertex order) differs in the last bits of its bound
-    return Tessellation(out_uv, out_tri, bound, dict(tess.limits),
-                        bool(tess.converged and (bound <= allowed[origin] * (1.0 + 1e-9)).all()))
-
-
-def _signed_area(T):
-    e1, e2 = T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]
-    return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-
-
-def _weld(uv, new, chains) -> tuple:
-    """Points ``new (N, 2)`` as vertex ids ``(points, index)``: an existing vertex of ``uv`` within ``_WELD``, else
-    a side chain point (snapped exactly), else one new vertex per cluster of points within ``_WELD``."""
-    from scipy.spatial import cKDTree
-
-    index = np.full(new.shape[0], -1, dtype=np.int64)
-    if new.size == 0:
-        return uv, index
-    d, j = cKDTree(uv).query(new, distance_upper_bound=_WELD)
-    hit = np.isfinite(d)
-    index[hit] = j[hit]
-    rest = np.flatnonzero(~hit)
-    q = new[rest].copy()
-    # snap to the sides: a point within _WELD of a side lies on it, at a chain point
-    for k, (axis, value, run) in enumerate(((1, 0.0, 0), (0, 1.0, 1), (1, 1.0, 0), (0, 0.0, 1))):
-        on = np.abs(q[:, axis] - value) <= _WELD
-        if on.any():
-            c = np.asarray(chains[k], dtype=np.float64)
-            pos = np.clip(np.searchsorted(c, q[on, run]), 1, c.size - 1)
-            near = np.where(np.abs(c[pos - 1] - q[on, run]) <= np.abs(c[pos] - q[on, run]), c[pos - 1], c[pos])
-            if (np.abs(near - q[on, run]) > 1e-9).any():
-                bad = q[on][np.argmax(np.abs(near - q[on, run]))]
-                raise RuntimeError(f"a trim vertex {bad.tolist()} lies on side {k} of the patch but not at a point of "
-                                   "its chain: the chains must hold every trim crossing (a crack otherwise)")
-            q[np.flatnonzero(on), run] = near
-            q[np.flatnonzero(on), axis] = value
-    # exact side points may now equal existing vertices
-    if rest.size:
-        d2, j2 = cKDTree(uv).query(q, distance_upper_bound=1e-15)
-        same = np.isfinite(d2)
-        index[rest[same]] = j2[same]
-        rest, q = rest[~same], q[~same]
-    if rest.size:
-        pairs = cKDTree(q).query_pairs(_WELD, output_type="ndarray")
-        root = np.arange(q.shape[0])
-        for a, b in pairs[np.argsort(pairs[:, 0])] if pairs.size else ():
-            ra, rb = _find(root, a), _find(root, b)
-            if ra != rb:
-                root[max(ra, rb)] = min(ra, rb)
-        root = np.array([_find(root, k) for k in range(q.shape[0])])
-        reps, inv = np.unique(root, return_inverse=True)
-        index[rest] = uv.shape[0] + inv
-        uv = np.concatenate([uv, q[reps]])
-    return uv, index
-
-
-def _find(root, a):
-    while root[a] != a:
-        root[a] = root[root[a]]
-        a = root[a]
-    return a
-
-
-def _fan_t_junctions(P, tri, origin, candidates):
-    """Split triangles having a ``candidates`` vertex strictly inside one of their sides (a fan through it),
-    until none has; ``origin`` follows the pieces."""
-    cand = np.asarray(candidates, dtype=np.int64)
-    for _ in range(64):
-        if cand.size == 0 or tri.size == 0:
-            return tri, origin
-        T = P[tri]  # (N, 3, 2)
-        a = T
-        e = np.roll(T, -1, axis=1) - T  # side k from vertex k to k + 1
-        L2 = np.einsum("nki,nki->nk", e, e)
-        rel = P[cand][None, None, :, :] - a[:, :, None, :]  # (N, 3, C, 2)
-        s = np.einsum("nkci,nki->nkc", rel, e)
-        cross = e[:, :, None, 0] * rel[..., 1] - e[:, :, None, 1] * rel[..., 0]
-        on = (np.abs(cross) <= 1e-12 * L2[..., None]) & (s > 1e-12 * L2[..., None]) & (s < (1 - 1e-12) * L2[..., None])
-        on &= (cand[None, None, :] != tri[:, :, None]).all(axis=1, keepdims=True)
-        hit = on.any(axis=2)
-        rows = np.flatnonzero(hit.any(axis=1))
-        if rows.size == 0:
-            return tri, origin
-        k = np.argmax(hit[rows], axis=1)
-        sk = np.where(on[rows, k], s[rows, k], np.inf)
-        c = cand[np.argmin(sk, axis=1)]  # the point nearest the side's start
-        v = tri[rows]
-        p, q, r = v[np.arange(rows.size), k], v[np.arange(rows.size), (k + 1) % 3], v[np.arange(rows.size), (k + 2) % 3]
-        keep = np.ones(tri.shape[0], dtype=bool)
-        keep[rows] = False
-        tri = np.concatenate([tri[keep], np.column_stack([p, c, r]), np.column_stack([c, q, r])])
-        origin = np.concatenate([origin[keep], origin[rows], origin[rows]])
-    raise RuntimeError("T-junction fanning did not settle after 64 rounds")
-
-
-def clip_patch(Pw, region, chains, target: float, tess: Tessellation, retries: int = 3) -> Tessellation:
-    """:func:`clip_tessellation` of a crossed patch's tessellation ``tess`` (made with ``chains`` at ``target``);
-    where a piece's proven bound exceeds what its triangle was accepted with, the patch is tessellated again at
-    half the target (same chains) and clipped again, up to ``retries`` times (``converged`` says if it held).
-
-    >>> import shapely
-    >>> from splinevis.nurbs.exact import saddle
-    >>> from splinevis.nurbs.lod.bezier import bezier_set
-    >>> from splinevis.nurbs.lod.adaptive import adaptive_tessellation
-    >>> Pw = bezier_set(saddle()).control(0)
-    >>> half = shapely.box(0.0, 0.0, 0.6, 1.0)
-    >>> c = clip_patch(Pw, half, [[0.0, 0.6, 1.0], [0.0, 1.0], [0.0, 0.6, 1.0], [0.0, 1.0]], 0.02,
-    ...                adaptive_tessellation(Pw, 0.02, [[0.0, 0.6, 1.0], None, [0.0, 0.6, 1.0], None]))
-    >>> c.converged, bool(c.uv[:, 0].max() == 0.6)
-    (True, True)
-    """
-    from .adaptive import adaptive_tessellation
-
-    out = clip_tessellation(tess, Pw, region, chains, target)
-    t = float(target)
-    for _ in range(int(retries)):
-        if out.converged:
-            break
-        t *= 0.5
-        again = adaptive_tessellation(Pw, t, chains)
-        out = clip_tessellation(again, Pw, region, chains, float(target))
-    return out
+    u0, u1, v0, v1 = (float(x) for x in rect)
+    return [np.column_stack([(r[:, 0] - u0) / (u1 - u0), (r[:, 1] - v0) / (v1 - v0)]) for r in rings]

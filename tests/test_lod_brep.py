@@ -1,0 +1,123 @@
+"""Trimmed solids from a CAD file through the levels of detail: faces meeting along trim curves share their
+border vertices [Kumar1997, sec. 4.2], so the mesh of a closed B-rep is closed at every level combination.
+
+Two solids are built with OpenCASCADE, converted to NURBS faces and written to STEP, then read back:
+a box with a straight cylindrical hole (the planes' trim circles meet the cylinder's natural sides) and a box
+with a tilted hole (the planes' trim ellipses meet the cylinder's trim curves, which OpenCASCADE writes as
+degree-8 pcurves and the reader brings to cubics).
+"""
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from splinevis.nurbs.lod.levels import assemble, build_lod
+from splinevis.nurbs.trim import inside, trim_pieces
+
+LEVELS = 3
+
+
+def _solid(path, tilted: bool):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    from splinevis.io.nurbs_step import _quiet_occ
+
+    _quiet_occ()
+    box = BRepPrimAPI_MakeBox(gp_Pnt(-2, -2, -1), 4.0, 4.0, 2.0).Shape()
+    axis = gp_Ax2(gp_Pnt(-1.5, 0, -3), gp_Dir(0.5, 0, 1)) if tilted else gp_Ax2(gp_Pnt(0, 0, -3), gp_Dir(0, 0, 1))
+    hole = BRepPrimAPI_MakeCylinder(axis, 0.7, 7.0).Shape()
+    shape = BRepBuilderAPI_NurbsConvert(BRepAlgoAPI_Cut(box, hole).Shape(), True).Shape()
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    writer.Write(str(path))
+    from splinevis.io import read_nurbs
+
+    return read_nurbs(path)
+
+
+@pytest.fixture(scope="module")
+def solids(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("brep")
+    out = {}
+    for name, tilted in (("straight", False), ("tilted", True)):
+        model = _solid(folder / f"{name}.step", tilted)
+        out[name] = (model, build_lod(model, 0.01, levels=LEVELS, progress=False, workers=1))
+    return out
+
+
+def _combos(lod, count=6):
+    S = len(lod.supers.members)
+    yield from (np.full(S, k) for k in range(lod.levels))
+    rng = np.random.default_rng(11)
+    for _ in range(count):
+        yield rng.integers(0, lod.levels, S)
+
+
+def test_the_reader_brings_high_degree_trim_curves_to_cubics(solids):
+    model, _ = solids["tilted"]
+    degrees = {c.degree for loops in model.trims if loops for loop in loops for c in loop}
+    assert max(degrees) <= 3
+    # the cylinder's trims lie on the planes z = +-1 or on its seam: map them to space and look
+    f = next(k for k, s in enumerate(model.surfaces) if s.degree != (1, 1))
+    s = model.surfaces[f]
+    (u0, u1), (v0, v1) = s.domain
+    for loop in model.trims[f]:
+        for c in loop:
+            uv = c.evaluate(np.linspace(*c.domain, 50))
+            uv = np.column_stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)])  # ends may be 1 ulp out
+            z = s.evaluate(uv[:, 0], uv[:, 1])[:, 2]
+            seam = np.isclose(uv[:, 0], u0, atol=1e-9) | np.isclose(uv[:, 0], u1, atol=1e-9)
+            assert (seam | (np.abs(np.abs(z) - 1.0) <= 1e-7)).all()
+
+
+@pytest.mark.parametrize("name", ["straight", "tilted"])
+def test_a_trimmed_solid_stays_a_closed_manifold_at_every_level_combination(solids, name):
+    _, lod = solids[name]
+    assert (lod.status == 1).any()  # trims cut patches
+    for level in _combos(lod):
+        points, tri, _ = assemble(lod, level)
+        e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+        _, counts = np.unique(e, axis=0, return_counts=True)
+        assert counts.min() == 2 and counts.max() == 2  # no crack along trims, no fold
+
+
+@pytest.mark.parametrize("name", ["straight", "tilted"])
+def test_the_trimmed_solid_is_within_its_bound(solids, name):
+    model, lod = solids[name]
+    pieces = trim_pieces(model.trims)
+    pts = []
+    for f, s in enumerate(model.surfaces):
+        (a, b), (c, d) = s.domain
+        u, v = (x.ravel() for x in np.meshgrid(np.linspace(a, b, 81), np.linspace(c, d, 81)))
+        keep = inside(pieces, f, u, v)
+        pts.append(s.evaluate(u[keep], v[keep]))
+    samples = pv.PolyData(np.concatenate(pts))
+    for level in _combos(lod, count=2):
+        points, tri, info = assemble(lod, level)
+        mesh = pv.PolyData(points, np.column_stack([np.full(len(tri), 3), tri]).ravel())
+        d = np.abs(samples.compute_implicit_distance(mesh)["implicit_distance"])
+        # the level's bound, plus the model tolerance by which a stitched vertex may move (1e-6 of the size)
+        assert d.max() <= info["bound"] + 1e-6 * lod.size
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", ["straight", "tilted"])
+@pytest.mark.parametrize("focus", [(0.0, 0.0, 0.0), (1.9, 1.9, 0.9), (-1.9, 0.5, -0.9)])
+def test_no_background_pixel_from_inside_a_trimmed_solid(solids, name, focus):
+    _, lod = solids[name]
+    for level in list(_combos(lod, count=2)):
+        points, tri, _ = assemble(lod, level)
+        pl = pv.Plotter(off_screen=True, window_size=(200, 150))
+        pl.set_background("black")
+        pl.add_mesh(pv.PolyData(points, np.column_stack([np.full(len(tri), 3), tri]).ravel()), color="white",
+                    lighting=False)
+        pl.camera_position = [(1.5, -1.5, 0.2), focus, (0.0, 0.0, 1.0)]  # in the material, between hole and wall
+        pl.camera.view_angle = 70.0
+        pl.camera.clipping_range = (1e-3, 20.0)
+        img = pl.screenshot()
+        pl.close()
+        assert (img.sum(axis=-1) == 0).sum() == 0
