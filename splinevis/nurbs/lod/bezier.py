@@ -27,7 +27,7 @@ from ..model import NurbsModel
 from ..operations import bezier_segments
 from ..surface import NurbsSurface
 
-__all__ = ["BezierGroup", "BezierSet", "bezier_set", "evaluate", "bernstein", "locate"]
+__all__ = ["BezierGroup", "BezierSet", "bezier_set", "evaluate", "bernstein", "locate", "patch_trims"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -378,3 +378,38 @@ def locate(bs, f: int, uv) -> tuple:
     s = np.clip((uv[:, 0] - rr[:, 0]) / (rr[:, 1] - rr[:, 0]), 0.0, 1.0)
     t = np.clip((uv[:, 1] - rr[:, 2]) / (rr[:, 3] - rr[:, 2]), 0.0, 1.0)
     return p, np.column_stack([s, t])
+
+
+def patch_trims(bezier, i: int, trims):
+    """The trim loops of patch ``i``'s surface (``trims``: the model's, per surface) in the patch's local domain
+    ``[0, 1]^2`` (control points mapped by the patch's rectangle: exact for rational curves), keeping only the
+    curves a ray towards ``+u`` from a point of the patch can cross (so the even-odd test inside the patch is
+    unchanged); None when the surface has no trims.
+
+    >>> from splinevis.nurbs.exact import saddle
+    >>> from splinevis.nurbs.model import TrimCurve
+    >>> from splinevis.nurbs.operations import refine_knots
+    >>> b = bezier_set(refine_knots(saddle(), 0, [0.5]))  # two patches, u in [0, 1/2] and [1/2, 1]
+    >>> line = lambda a, b: TrimCurve(1, [0, 0, 1, 1], [a, b])
+    >>> loop = [line([0.1, 0.2], [0.3, 0.2]), line([0.3, 0.2], [0.1, 0.2])]
+    >>> patch_trims(b, 0, [[loop]])[0][0].control_points.tolist(), patch_trims(b, 1, [[loop]])
+    ([[0.2, 0.2], [0.6, 0.2]], [])
+    """
+    from ..model import TrimCurve
+
+    loops = trims[int(bezier.parent[i])] if trims is not None else None
+    if loops is None:
+        return None
+    u0, u1, v0, v1 = (float(x) for x in bezier.rect[i])
+    out = []
+    for loop in loops:
+        kept = []
+        for c in loop:
+            P = np.asarray(c.control_points, dtype=np.float64)
+            if P[:, 1].max() < v0 or P[:, 1].min() > v1 or P[:, 0].max() < u0:
+                continue  # no ray from the patch towards +u meets it
+            Q = np.column_stack([(P[:, 0] - u0) / (u1 - u0), (P[:, 1] - v0) / (v1 - v0)])
+            kept.append(TrimCurve(c.degree, c.knots, Q, c.weights))
+        if kept:
+            out.append(kept)
+    return out

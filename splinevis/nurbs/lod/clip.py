@@ -126,7 +126,8 @@ def _cdt(points, edges):
     return np.column_stack([v["x"], v["y"]]), np.asarray(t.triangles_array()["vertices"], dtype=np.int64)
 
 
-def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rings=None, rounds: int = 8) -> Tessellation:
+def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rings=None,
+                      rounds: int = 8) -> Tessellation:
     """The tessellation ``tess`` of a patch (local domain) cut to ``region`` (shapely, local domain) whose trim
     polylines are ``rings`` (closed ``(K, 2)`` in the local domain; default: the region's boundary) by the
     method of the module docstring; ``chains``: the 4 sides' chains as the patch sees them. ``converged`` is
@@ -168,7 +169,8 @@ def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rin
     bv = np.setdiff1d(np.unique(tri[band]), np.unique(tri[whole]))
     q = uv[bv]
     on_side = (q[:, 0] == 0.0) | (q[:, 0] == 1.0) | (q[:, 1] == 0.0) | (q[:, 1] == 1.0)
-    keep = shapely.intersects_xy(region, q[:, 0], q[:, 1]) & (on_side | (shapely.distance(shapely.points(q), lines) > 1e-9))
+    off_line = shapely.distance(shapely.points(q), lines) > 1e-9 if lines is not None else np.ones(len(q), dtype=bool)
+    keep = shapely.intersects_xy(region, q[:, 0], q[:, 1]) & (on_side | off_line)
     base = np.concatenate([np.unique(tri[whole]), bv[keep]])
     ring_pts = np.concatenate(pieces) if pieces else np.zeros((0, 2))
     allowed_t = np.maximum(float(target), tess.bound)

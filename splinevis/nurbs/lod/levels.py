@@ -105,6 +105,7 @@ class LodModel:
     delta_trim: float = 0.0  # the share of each level's bound taken by the trim polylines (0: no trims)
     vertex_patch: np.ndarray = None  # (V,) a Bezier patch each vertex lies on (a shared one: the edge's first side)
     vertex_uv: np.ndarray = None  # (V, 2) its local parameters there
+    trims: tuple = None  # per surface of the model: its trim loops (TrimCurve lists) or None
     status: np.ndarray = None  # (P,) per Bezier patch: 0 untrimmed or inside its trims, 1 clipped, -1 trimmed away
 
     @property
@@ -466,7 +467,8 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         boxes[s] = [b[:, 0].min(), b[:, 1].max(), b[:, 2].min(), b[:, 3].max(), b[:, 4].min(), b[:, 5].max()]
     return LodModel(bs, edges, supers, build_bvh(boxes), boxes, tolerance, counts, bs.size, vertices,
                     tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified, normals,
-                    delta_trim=delta_trim, status=status, vertex_patch=vertex_patch, vertex_uv=vertex_uv)
+                    delta_trim=delta_trim, status=status, vertex_patch=vertex_patch, vertex_uv=vertex_uv,
+                    trims=tuple(model.trims) if trimmed else None)
 
 
 def _between(lod, eid, a, b, level):

@@ -34,7 +34,8 @@ import numpy as np
 from .adaptive import _curve_chains
 from .bounds import _curve_points_rows
 
-__all__ = ["TrimPlan", "face_rings", "split_segments", "trim_plan", "gradient_bound", "trim_polylines", "merge_params", "local_rings"]
+__all__ = ["TrimPlan", "face_rings", "split_segments", "trim_plan", "gradient_bound", "trim_polylines",
+           "merge_params", "local_rings"]
 
 _WELD = 1e-11  # local-domain distance under which two computed points are one vertex (rounding of intersections)
 
