@@ -321,16 +321,28 @@ def test_step_bspline_and_trimmed_faces(tmp_path):
     assert m.skipped == {}
 
 
-def test_step_and_iges_skip_analytic_faces(tmp_path):
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+def test_step_converts_analytic_faces_to_nurbs(tmp_path):
+    """Planes and a cylinder as CAD files hold them: converted exactly by OpenCASCADE, trims with them."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
     f = tmp_path / "box.stp"
     w = STEPControl_Writer()
-    w.Transfer(BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape(), STEPControl_AsIs)
+    hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0.5, 0.5, -1), gp_Dir(0, 0, 1)), 0.25, 3.0).Shape()
+    w.Transfer(BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape(), hole).Shape(), STEPControl_AsIs)
     w.Write(str(f))
-    with pytest.raises(ValueError, match=r"box.stp holds no supported NURBS surface.*6 x face on Geom_Plane"):
-        read_nurbs(f)
+    m = read_nurbs(f)
+    assert len(m) == 7 and m.skipped == {}
+    assert "7 analytic faces converted to NURBS by OpenCASCADE (1 x Geom_CylindricalSurface, 6 x Geom_Plane)" in m.source
+    assert m.bounds() == pytest.approx((0.0, 1.0, 0.0, 1.0, 0.0, 1.0), abs=1e-12)
+    cyl = next(s for s in m.surfaces if s.degree != (1, 1))
+    (u0, u1), (v0, v1) = cyl.domain
+    g = np.linspace(0.0, 1.0, 9)
+    P = cyl.evaluate(u0 + g * (u1 - u0), v0 + g * (v1 - v0))
+    assert np.abs(np.hypot(P[:, 0] - 0.5, P[:, 1] - 0.5) - 0.25).max() < 1e-12  # the exact circle: rational
+    assert sum(len(loops) for loops in m.trims if loops) == 9  # 7 outer wires, the top and bottom holes
 
 
 def test_step_without_ocp_says_what_to_install(tmp_path, monkeypatch):

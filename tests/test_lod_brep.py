@@ -1,8 +1,8 @@
 """Trimmed solids from a CAD file through the levels of detail: faces meeting along trim curves share their
 border vertices [Kumar1997, sec. 4.2], so the mesh of a closed B-rep is closed at every level combination.
 
-Two solids are built with OpenCASCADE, converted to NURBS faces and written to STEP, then read back:
-a box with a straight cylindrical hole (the planes' trim circles meet the cylinder's natural sides) and a box
+Two solids are built with OpenCASCADE and written to STEP as CAD systems write them (planes, cylinders), then
+read back (the reader converts the analytic faces to NURBS): a box with a straight cylindrical hole (the planes' trim circles meet the cylinder's natural sides) and a box
 with a tilted hole (the planes' trim ellipses meet the cylinder's trim curves, which OpenCASCADE writes as
 degree-8 pcurves and the reader brings to cubics).
 """
@@ -19,7 +19,6 @@ LEVELS = 3
 
 def _solid(path, tilted: bool):
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
     from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
@@ -30,7 +29,7 @@ def _solid(path, tilted: bool):
     box = BRepPrimAPI_MakeBox(gp_Pnt(-2, -2, -1), 4.0, 4.0, 2.0).Shape()
     axis = gp_Ax2(gp_Pnt(-1.5, 0, -3), gp_Dir(0.5, 0, 1)) if tilted else gp_Ax2(gp_Pnt(0, 0, -3), gp_Dir(0, 0, 1))
     hole = BRepPrimAPI_MakeCylinder(axis, 0.7, 7.0).Shape()
-    shape = BRepBuilderAPI_NurbsConvert(BRepAlgoAPI_Cut(box, hole).Shape(), True).Shape()
+    shape = BRepAlgoAPI_Cut(box, hole).Shape()
     writer = STEPControl_Writer()
     writer.Transfer(shape, STEPControl_AsIs)
     writer.Write(str(path))

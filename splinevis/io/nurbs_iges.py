@@ -103,14 +103,14 @@ def _read_ocp(path: Path):
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.IGESControl import IGESControl_Reader
 
-    from .nurbs_step import _quiet_occ, shape_faces
+    from .nurbs_step import _quiet_occ, converted_note, shape_faces
 
     _quiet_occ()
     reader = IGESControl_Reader()
     if reader.ReadFile(str(path)) != IFSelect_RetDone:
         raise ValueError(f"{path}: OpenCASCADE could not read this file as IGES; is it a valid IGES 5.x file?")
     model = reader.Model()
-    surfaces, trims, skipped, contents = [], [], {}, {}
+    surfaces, trims, skipped, contents, converted = [], [], {}, {}, {}
     for i in range(1, model.NbEntities() + 1):
         ent = model.Entity(i)
         t = ent.TypeNumber()
@@ -126,10 +126,10 @@ def _read_ocp(path: Path):
         if not reader.TransferOne(i) or reader.NbShapes() == before:
             skipped[f"{_type_key(t)}, not transferred"] = skipped.get(f"{_type_key(t)}, not transferred", 0) + 1
             continue
-        s, tr = shape_faces(reader.Shape(reader.NbShapes()), path, skipped, prefix=name)
+        s, tr = shape_faces(reader.Shape(reader.NbShapes()), path, skipped, prefix=name, converted=converted)
         surfaces += s
         trims += tr
-    return build_model(path, "IGES (OCP)", surfaces, trims, skipped, contents)
+    return build_model(path, "IGES (OCP)" + converted_note(converted), surfaces, trims, skipped, contents)
 
 
 # --------------------------------------------------------------------------------------------------

@@ -117,9 +117,9 @@ def read_step(path) -> NurbsModel:
             raise _Unreadable(_unreadable(path)) from None
         reader.TransferRoots()
         return shape_to_model(reader.OneShape(), path, f"STEP (OCP, plain reader; names not read: {why})", {})
-    skipped = {}
-    surfaces, trims = shape_faces(shape, path, skipped, names=names.name)
-    return build_model(path, "STEP (OCP)", surfaces, trims, skipped)
+    skipped, converted = {}, {}
+    surfaces, trims = shape_faces(shape, path, skipped, names=names.name, converted=converted)
+    return build_model(path, "STEP (OCP)" + converted_note(converted), surfaces, trims, skipped)
 
 
 class _Unreadable(ValueError):
@@ -292,7 +292,8 @@ def _faces(shape) -> list:
 
 
 def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
-    """Turn an OCP shape's B-spline faces into a NurbsModel (see the module notes).
+    """Turn an OCP shape's faces into a NurbsModel (analytic faces converted, :func:`shape_faces`; see the
+    module notes).
 
     Parameters
     ----------
@@ -307,20 +308,20 @@ def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
     Examples
     --------
     >>> from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-    >>> import warnings
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore")
-    ...     shape_to_model(BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape(), "box", "OCP shape", {})
-    Traceback (most recent call last):
-    ValueError: box holds no supported NURBS surface (OCP shape); it contains: 6 x face on Geom_Plane.
+    >>> m = shape_to_model(BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape(), "box", "OCP shape", {})
+    >>> len(m), m.bounds(), "6 analytic faces converted to NURBS by OpenCASCADE (6 x Geom_Plane)" in m.source
+    (6, (0.0, 1.0, 0.0, 1.0, 0.0, 1.0), True)
     """
-    skipped = dict(skipped)
-    surfaces, trims = shape_faces(shape, path, skipped)
-    return build_model(path, kind, surfaces, trims, skipped)
+    skipped, converted = dict(skipped), {}
+    surfaces, trims = shape_faces(shape, path, skipped, converted=converted)
+    return build_model(path, kind + converted_note(converted), surfaces, trims, skipped)
 
 
-def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None) -> tuple:
-    """``(surfaces, trims)`` of an OCP shape's B-spline faces; other faces are counted in ``skipped``.
+def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None, converted=None) -> tuple:
+    """``(surfaces, trims)`` of an OCP shape's faces. A face on an analytic surface (plane, cylinder, cone,
+    sphere, torus, extrusion, revolution, offset) is converted to a B-spline face by OpenCASCADE
+    (``BRepBuilderAPI_NurbsConvert``, exact: these surfaces are rational) and counted in ``converted`` (surface
+    type -> count) when a dict is given; a face OpenCASCADE cannot convert is counted in ``skipped``.
 
     Faces are named ``names(face, k)`` when that gives a name (``names``: a function of the
     ``TopoDS_Face`` and its index ``k`` in the shape, returning a str or None), else
@@ -355,7 +356,11 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None) -> tup
         if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
             surf = surf.BasisSurface()
         kind_name = "no surface" if surf is None else surf.DynamicType().Name()
-        if kind_name != "Geom_BSplineSurface":
+        if kind_name != "Geom_BSplineSurface" and surf is not None:
+            face, surf = _nurbs_face(face)
+            if surf is not None and converted is not None:
+                converted[kind_name] = converted.get(kind_name, 0) + 1
+        if surf is None or surf.DynamicType().Name() != "Geom_BSplineSurface":
             key = f"face on {kind_name}"
             skipped[key] = skipped.get(key, 0) + 1
             continue
@@ -366,6 +371,36 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None) -> tup
         surfaces.append(surface)
         trims.append(loops)
     return surfaces, trims
+
+
+def _nurbs_face(face):
+    """The face converted to a B-spline face by OpenCASCADE and its surface, or ``(face, None)``."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.TopoDS import TopoDS
+
+    try:
+        new = TopoDS.Face(BRepBuilderAPI_NurbsConvert(face, True).Shape())
+    except Exception:  # noqa: BLE001 -- OpenCASCADE refuses: the face is skipped and counted
+        return face, None
+    surf = BRep_Tool.Surface_s(new)
+    if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
+        surf = surf.BasisSurface()
+    return new, surf
+
+
+def converted_note(converted: dict) -> str:
+    """The ``source`` note of faces converted to NURBS.
+
+    >>> converted_note({"Geom_Plane": 6, "Geom_CylindricalSurface": 1})
+    '; 7 analytic faces converted to NURBS by OpenCASCADE (1 x Geom_CylindricalSurface, 6 x Geom_Plane)'
+    >>> converted_note({})
+    ''
+    """
+    if not converted:
+        return ""
+    parts = ", ".join(f"{n} x {k}" for k, n in sorted(converted.items()))
+    return f"; {sum(converted.values())} analytic faces converted to NURBS by OpenCASCADE ({parts})"
 
 
 def bspline_surface(surf, name: str = "") -> NurbsSurface:
