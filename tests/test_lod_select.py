@@ -121,6 +121,12 @@ def test_level_is_monotone_in_distance_and_pixel_error():
         assert stats["needs_finer"] == int((~ok).sum())
         coarser = levels + 1 < lod.tolerance.size
         assert (err[np.flatnonzero(coarser), levels[coarser] + 1] > pe).all()
+        # finer steps where level 0 is too coarse: the smallest j with tol_0 / 4**j within the bound (brute force)
+        need = np.zeros(distances.size, dtype=np.int64)
+        for i in np.flatnonzero(~ok):
+            need[i] = next(j for j in range(1, 99) if err[i, 0] / 4.0 ** j <= pe * (1 + 1e-12))
+        np.testing.assert_array_equal(stats["finer_steps"], np.minimum(need, 4))
+        assert stats["finer_capped"] == int((need > 4).sum())
     levels, stats = select_levels(lod, (0, 0, 0), M, 480, pixel_error=None)
     assert (levels == 0).all() and stats["needs_finer"] == 0
 
@@ -130,6 +136,12 @@ def test_eye_inside_a_box_gets_the_finest_level():
     M = _perspective(math.radians(30.0), 1.0, 0.1, 1e4) @ _look_at((0, 0, 0), (0, 0, -1), (0, 1, 0))
     levels, stats = select_levels(lod, (0, 0, 0), M, 480, pixel_error=1.0, cull_back=False)
     assert levels[0] == 0 and stats["needs_finer"] >= 1
+    # infinitely many finer steps: the cap, counted where it binds
+    assert stats["finer_steps"][0] == 4 and stats["finer_capped"] >= 1
+    _, stats = select_levels(lod, (0, 0, 0), M, 480, pixel_error=1.0, cull_back=False, max_finer=2, finer_ratio=2.0)
+    assert stats["finer_steps"][0] == 2
+    with pytest.raises(ValueError, match="finer_ratio must be > 1"):
+        select_levels(lod, (0, 0, 0), M, 480, finer_ratio=1.0)
 
 
 def test_field_of_view_from_the_matrix_and_parallel_projection():

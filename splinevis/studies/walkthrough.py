@@ -6,19 +6,26 @@ threaded pipeline [Kumar1997], measured on this machine (Mesa llvmpipe, no GPU).
   ``delta``; the triangles of each level and the mean frame time and triangles of the fly-through
   (:func:`splinevis.nurbs.lod.pipeline.camera_path`) at one pixel of error; then the main model's fly-through
   at pixel errors 0.5 .. 8.
-* **(b) LOD against uniform tessellation at equal measured deviation.** Every super-surface at one level (a
-  static mesh) against :func:`splinevis.nurbs.tessellate.tessellate` at ``per_span = 1 .. 8``, the deviation
-  of both measured the same way (:func:`measured_deviation`); for each level the coarsest uniform mesh that
-  is at least as accurate, with triangles and frame times side by side.
+* **(b) LOD against uniform tessellation and OpenCASCADE at equal measured deviation.** Every super-surface
+  at one level (a static mesh) against :func:`splinevis.nurbs.tessellate.tessellate` at ``per_span = 1 .. 16``
+  and against OpenCASCADE's mesher (:func:`splinevis.studies.nurbs_occ.occ_tessellate`, when OCP is importable)
+  at deflections from half the finest tolerance to the coarsest, the deviation of all measured the same way
+  (:func:`splinevis.studies.walkthrough_compare.measured_deviation`); for each level the coarsest uniform and
+  OpenCASCADE mesh that is at least as accurate, with triangles and frame times side by side.
 * **(c) Each part switched on in turn** on the main model (a teapot field, 40,000 patches in the full run,
   2,016 with ``quick``): nothing (every super-surface at the finest level), + frustum culling, + back-patch
   culling, + levels of detail (one pixel), + threads (:class:`splinevis.nurbs.lod.pipeline.Walkthrough`).
 * **(d) The paper's headline** in columns labelled ``paper`` beside our fps (the ship hull too).
+* **(e) Simplified levels** [Kumar1997, sec. 4] where super-surfaces span many patches: the ship hull without
+  portholes built without and with :class:`splinevis.nurbs.lod.simplify.Simplifier`; per level the proven part
+  ``delta_l``, ``eps_l``, the triangles, the Simplifier's measured distance against ``delta_l + eps_l`` and
+  the study's measured deviation; and the fly-through of both (same path, same pixel error).
 
 Frames are 800x600 without multisampling (llvmpipe's 4x multisampling costs ~70 ms a frame alone and is
 the same for every configuration). Level-of-detail models are cached as pickles ``(lod, build seconds)`` in
 ``out_dir/lod_cache``, keyed by the parameters and :func:`code_version`, and reused by later runs (building
-the 40,000-patch field took 133 s here); the full run takes about 6 minutes, ``quick`` about one.
+the 40,000-patch field took 133 s here); the full run takes about 10 minutes (of them the OpenCASCADE meshes of
+(b) about 2 and section (e) about 1.5, measured alone on the shared machine), ``quick`` about one.
 """
 
 from __future__ import annotations
@@ -32,10 +39,11 @@ import numpy as np
 
 from .report import (clean, log, md_table, paper_columns, paper_table, progress_bar, pyplot, save_figure,
                      write_json)
+from .walkthrough_compare import (WINDOW, lod_bounds, lod_vs_meshes, measured_deviation, occ_deflections, plotter,
+                                  simplification_levels)
 
 __all__ = ["run_walkthrough_study", "measured_deviation", "code_version", "PAPER_ROWS"]
 
-WINDOW = (800, 600)
 #: [Kumar1997]: SGI Onyx, three 200 MHz R4400 CPUs, RealityEngine2 graphics; the Door model (38,750 Bezier
 #: patches). Abstract: "almost 40,000 Bezier patches at 7 - 15 frames a second"; sec. 6: sequential ~2 fps,
 #: parallel 8 - 10 fps, dynamic tessellation without static levels of detail [21] 1.4 fps.
@@ -56,15 +64,19 @@ PARTS = [("none (finest level, no culling)", dict(cull_frustum=False, cull_back=
 def _settings(quick):
     if quick:
         return {"main": ("teapot", 63), "main_delta": 0.1, "small": ("teapot", 2), "deltas": (0.03, 0.1, 0.3),
-                "hull": ("hull", 300), "hull_delta": 0.01, "frames": 40, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0)}
+                "hull": ("hull", 300), "hull_delta": 0.01, "frames": 40, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0),
+                "simplify": ("hull_noportholes", 300), "simplify_delta": 0.01, "simplify_samples": 12, "repeats": 1,
+                "occ_step": 4.0}
     return {"main": ("teapot", 1250), "main_delta": 0.1, "small": ("teapot", 16), "deltas": (0.01, 0.03, 0.1, 0.3),
-            "hull": ("hull", 10000), "hull_delta": 0.005, "frames": 120, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0)}
+            "hull": ("hull", 10000), "hull_delta": 0.005, "frames": 120, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0),
+            "simplify": ("hull_noportholes", 10000), "simplify_delta": 0.005, "simplify_samples": 8, "repeats": 2,
+            "occ_step": np.sqrt(2.0)}
 
 
 def _model(kind, n):
     from datasets_synthetic.large_models import hull, teapot_field
 
-    return teapot_field(n) if kind == "teapot" else hull(n)
+    return teapot_field(n) if kind == "teapot" else hull(n, portholes=kind == "hull")
 
 
 def code_version() -> str:
@@ -87,30 +99,28 @@ def code_version() -> str:
     return h.hexdigest()[:10]
 
 
-def _lod(cache, kind, n, delta, levels=4, progress=True, version=None):
+def _lod(cache, kind, n, delta, levels=4, progress=True, version=None, simplify=None):
     """``(lod, build seconds, patches)`` from the cache or built (and cached); ``version``: the
-    :func:`code_version` of the run (taken once, so that one run uses one key)."""
+    :func:`code_version` of the run (taken once, so that one run uses one key); ``simplify``: a
+    :class:`~splinevis.nurbs.lod.simplify.Simplifier` or None."""
     from ..nurbs.lod.levels import build_lod
 
-    path = Path(cache) / f"{kind}{n}_delta{delta:g}_levels{levels}_{version or code_version()}.pkl"
+    key = "" if simplify is None else f"_simplify{simplify.share:g}-{simplify.samples}-{simplify.target:g}"
+    path = Path(cache) / f"{kind}{n}_delta{delta:g}_levels{levels}{key}_{version or code_version()}.pkl"
     if path.exists():
         with open(path, "rb") as f:
             lod, seconds = pickle.load(f)
         return lod, float(seconds), len(lod.bezier)
     model = _model(kind, n)
-    log("walkthrough", f"building levels of detail of {model.source} at delta {delta:g} (cached in {cache})")
+    log("walkthrough", f"building levels of detail of {model.source} at delta {delta:g}"
+        f"{'' if simplify is None else ', simplified'} (cached in {cache})")
     t0 = time.perf_counter()
-    lod = build_lod(model, float(delta), levels=levels, progress=progress)
+    lod = build_lod(model, float(delta), levels=levels, simplify=simplify, progress=progress)
     seconds = time.perf_counter() - t0
     Path(cache).mkdir(parents=True, exist_ok=True)
     with open(path, "wb") as f:
         pickle.dump((lod, seconds), f, protocol=pickle.HIGHEST_PROTOCOL)
     return lod, seconds, len(lod.bezier)
-
-
-def _bounds(lod):
-    b = np.asarray(lod.boxes)
-    return [b[:, 0].min(), b[:, 1].max(), b[:, 2].min(), b[:, 3].max(), b[:, 4].min(), b[:, 5].max()]
 
 
 def _path(lod, frames):
@@ -119,25 +129,16 @@ def _path(lod, frames):
 
     b = np.asarray(lod.boxes)
     centres = 0.5 * (b[:, 0::2] + b[:, 1::2])
-    mid = 0.5 * (np.asarray(_bounds(lod))[0::2] + np.asarray(_bounds(lod))[1::2])
+    mid = 0.5 * (np.asarray(lod_bounds(lod))[0::2] + np.asarray(lod_bounds(lod))[1::2])
     k = int(np.argmin(np.linalg.norm(centres[:, :2] - mid[:2], axis=1)))
-    return camera_path(_bounds(lod), frames, target=(centres[k, 0], centres[k, 1], b[k, 5]))
-
-
-def _plotter():
-    import pyvista as pv
-
-    pl = pv.Plotter(off_screen=True, window_size=WINDOW)
-    pl.render_window.SetMultiSamples(0)
-    pl.set_background("white")
-    return pl
+    return camera_path(lod_bounds(lod), frames, target=(centres[k, 0], centres[k, 1], b[k, 5]))
 
 
 def _fly(lod, path, **options) -> tuple:
     """(summary row, per-frame rows) of one fly-through."""
     from ..nurbs.lod.pipeline import Walkthrough
 
-    pl = _plotter()
+    pl = plotter()
     try:
         frames = Walkthrough(lod, pl, **options).fly(path, progress=False)
     finally:
@@ -152,97 +153,6 @@ def _fly(lod, path, **options) -> tuple:
            "assemble_ms_max": float(max(f["assemble_ms"] for f in frames)), "render_ms_mean": mean("render_ms"),
            "new_meshes": int(sum(f["new_mesh"] for f in frames))}
     return row, frames
-
-
-def measured_deviation(mesh, model, samples_per_span: int = 24) -> float:
-    """Largest distance between a triangle mesh and the surfaces of ``model``, measured both ways: from dense
-    surface points (:func:`splinevis.nurbs.tessellate.tessellate` vertices at ``samples_per_span``, exact
-    surface points) to the mesh, and from the mesh's edge midpoints and centroids to the dense surface mesh.
-    The same measure for every mesh, so deviations compare. The dense mesh's own chord error enters the second
-    part: on the teapots 24 per span changes a deviation of 0.018 by 4e-4 against 40 per span (measured);
-    compare meshes several times coarser than the dense one.
-
-    Examples
-    --------
-    >>> from splinevis.nurbs.exact import cylinder
-    >>> from splinevis.nurbs.tessellate import tessellate
-    >>> d = measured_deviation(tessellate(cylinder(1.0), 4), cylinder(1.0))
-    >>> 0.015 < d < 0.025  # about 1 - cos(pi / 16) = 0.019 (the chord_deviation example)
-    True
-    """
-    import pyvista as pv
-
-    from ..nurbs.tessellate import tessellate
-
-    dense = tessellate(model, int(samples_per_span))
-    target = pv.PolyData(np.asarray(mesh.points), faces=mesh.faces)
-    a = np.abs(pv.PolyData(dense.points).compute_implicit_distance(target)["implicit_distance"]).max()
-    tri = mesh.faces.reshape(-1, 4)[:, 1:]
-    P = np.asarray(mesh.points)[tri]
-    probes = np.concatenate([P.mean(axis=1), 0.5 * (P[:, 0] + P[:, 1]), 0.5 * (P[:, 1] + P[:, 2]),
-                             0.5 * (P[:, 2] + P[:, 0])])
-    surface = pv.PolyData(dense.points, faces=dense.faces)
-    b = np.abs(pv.PolyData(probes).compute_implicit_distance(surface)["implicit_distance"]).max()
-    return float(max(a, b))
-
-
-def _frame_ms(mesh, bounds, repeats=5) -> float:
-    """Median frame time of one mesh seen whole (flat shaded, like the walkthrough)."""
-    import pyvista as pv
-
-    pl = _plotter()
-    try:
-        pl.add_mesh(pv.PolyData(np.asarray(mesh.points), faces=mesh.faces), color="tan")
-        b = np.asarray(bounds)
-        c = 0.5 * (b[0::2] + b[1::2])
-        D = float(np.linalg.norm(b[1::2] - b[0::2]))
-        pl.camera_position = [tuple(c + D * np.array([0.6, -0.8, 0.5])), tuple(c), (0.0, 0.0, 1.0)]
-        pl.reset_camera_clipping_range()
-        pl.show(auto_close=False)
-        times = []
-        for _ in range(repeats + 1):
-            t0 = time.perf_counter()
-            pl.render_window.Render()
-            times.append(time.perf_counter() - t0)
-        return 1e3 * float(np.median(times[1:]))
-    finally:
-        pl.close()
-
-
-def _static_mesh(lod, level):
-    import pyvista as pv
-
-    from ..nurbs.lod.levels import assemble
-
-    points, tri, _ = assemble(lod, np.full(len(lod.supers.members), level, dtype=np.int64))
-    return pv.PolyData(np.asarray(points), faces=pv.CellArray.from_regular_cells(np.asarray(tri, dtype=np.int64)))
-
-
-def lod_vs_uniform(lod, model, per_spans=range(1, 17)) -> dict:
-    """(b): rows per LOD level and per uniform ``per_span``, and the matches (module docstring)."""
-    from ..nurbs.tessellate import tessellate
-
-    bounds = _bounds(lod)
-    levels, uniform = [], []
-    for level in range(lod.levels):
-        mesh = _static_mesh(lod, level)
-        levels.append({"mesh": f"LOD level {level}", "bound": float(lod.tolerance[level]), "triangles": mesh.n_cells,
-                       "deviation": measured_deviation(mesh, model), "frame_ms": _frame_ms(mesh, bounds)})
-    for p in per_spans:
-        mesh = tessellate(model, int(p))
-        uniform.append({"mesh": f"uniform per_span={p}", "per_span": int(p), "triangles": mesh.n_cells,
-                        "deviation": measured_deviation(mesh, model), "frame_ms": _frame_ms(mesh, bounds)})
-    matches = []
-    for row in levels:
-        ok = [u for u in uniform if u["deviation"] <= row["deviation"]]
-        u = min(ok, key=lambda r: r["triangles"]) if ok else None
-        matches.append({"level": row["mesh"], "lod_deviation": row["deviation"], "lod_triangles": row["triangles"],
-                        "lod_frame_ms": row["frame_ms"], "uniform": u["mesh"] if u else f"none of per_span <= {max(per_spans)}",
-                        "uniform_deviation": u["deviation"] if u else None,
-                        "uniform_triangles": u["triangles"] if u else None,
-                        "uniform_frame_ms": u["frame_ms"] if u else None,
-                        "triangle_ratio": (u["triangles"] / row["triangles"]) if u else None})
-    return {"levels": levels, "uniform": uniform, "matches": matches}
 
 
 def _parts(lod, path, progress) -> tuple:
@@ -279,7 +189,7 @@ def _views(out, lod, path, picks=(0.0, 0.3, 0.59, 1.0)):
 
     chosen = [path[min(int(round(t * (len(path) - 1))), len(path) - 1)] for t in picks]
     with tempfile.TemporaryDirectory() as tmp:
-        pl = _plotter()
+        pl = plotter()
         try:
             Walkthrough(lod, pl, threaded=False, pixel_error=1.0).fly(chosen, frames_dir=tmp, progress=False)
         finally:
@@ -337,6 +247,29 @@ def _figures(out, result):
     axes[1].set_title(result["main"]["source"], fontsize=9)
     axes[1].grid(True, which="both", alpha=0.3)
     save_figure(fig, out / "walkthrough_triangles.png")
+    b, e = result["lod_vs_meshes"], result["simplification"]
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
+    for rows, style, label in ((b["levels"], "ko-", "LOD levels (all super-surfaces)"),
+                               (b["uniform"], "s--", "uniform per_span"), (b["occ"] if b["occ_available"] else [],
+                                                                          "^--", "OpenCASCADE BRepMesh")):
+        rows = sorted(rows, key=lambda r: r["deviation"])  # OpenCASCADE's deviation is not monotone in deflection
+        if rows:
+            axes[0].plot([r["deviation"] for r in rows], [r["triangles"] for r in rows], style, label=label, ms=4)
+    axes[0].set_title(f"(b) {result['small']['source']}", fontsize=9)
+    axes[1].plot([r["level"] for r in e["levels"]], [r["triangles_plain"] for r in e["levels"]], "o-", label="plain")
+    axes[1].plot([r["level"] for r in e["levels"]], [r["triangles_simplified"] for r in e["levels"]], "s--",
+                 label="simplified")
+    axes[1].set_xticks([r["level"] for r in e["levels"]])
+    axes[1].set_title(f"(e) {e['source'].split(' (')[0]} without portholes", fontsize=9)
+    axes[0].set_xlabel("measured deviation (model units)")
+    axes[1].set_xlabel("level")
+    for ax in axes:
+        ax.set_yscale("log")
+        ax.set_ylabel("triangles")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    axes[0].set_xscale("log")
+    save_figure(fig, out / "walkthrough_meshes.png")
 
 
 def write_markdown(out, result) -> Path:
@@ -346,12 +279,14 @@ def write_markdown(out, result) -> Path:
     --------
     See :func:`run_walkthrough_study` (minutes); the tables come from :func:`splinevis.studies.report.md_table`.
     """
-    m, h = result["main"], result["hull"]
+    m, h, b, e = result["main"], result["hull"], result["lod_vs_meshes"], result["simplification"]
+    for r in e["levels"]:
+        r["reduced"] = f"{r['supers_reduced']} of {r['supers']}"
     fly_cols = [("frame mean (ms)", "frame_mean_ms", "f1"), ("fps", "fps", "f1"), ("frame max (ms)", "frame_max_ms", "f1"),
                 ("triangles (mean)", "triangles_mean", "int"), ("visible super-surfaces", "visible_mean", "f1"),
                 ("mesh age mean / max", "age", "s"), ("select (ms)", "select_ms_mean", "f2"),
                 ("assemble max (ms)", "assemble_ms_max", "f1"), ("render (ms)", "render_ms_mean", "f1")]
-    for r in result["parts"] + result["vs_pixel_error"] + result["vs_delta"] + result["headline"]:
+    for r in result["parts"] + result["vs_pixel_error"] + result["vs_delta"] + result["headline"] + e["flights"]:
         if "mesh_age_mean" in r:
             r["age"] = f"{r['mesh_age_mean']:.2f} / {r['mesh_age_max']}"
     t = result["threads"]
@@ -375,7 +310,8 @@ def write_markdown(out, result) -> Path:
           "", f"Threads, alternated runs: sequential {', '.join(f'{x:.1f}' for x in t['sequential_ms'])} ms, threaded "
           f"{', '.join(f'{x:.1f}' for x in t['threaded_ms'])} ms a frame: speed-up {t['speedup']:.2f}.", "",
           result["thread_note"], "", "![frame times](walkthrough_frames.png)", "",
-          "Frames of the fly-through (every part on; flat shading, the mesh carries no normals):", "",
+          "Frames of the fly-through (every part on; smooth shading, every vertex carries the surface's exact "
+          "normal):", "",
           "![views](walkthrough_views.png)", "",
           f"## (a) Against delta ({result['small']['source']}) and against pixel error ({m['source']})", "",
           md_table(result["vs_delta"], [("delta", "delta", "e"), ("build (s)", "build_s", "f1"),
@@ -383,22 +319,52 @@ def write_markdown(out, result) -> Path:
                                         ("triangles per level (all drawn)", "per_level", "s")] + fly_cols), "",
           md_table(result["vs_pixel_error"], [("pixel error", "pixel_error", "f2"), ("needs finer (mean)", "needs_finer", "f1")]
                    + fly_cols), "", "![triangles](walkthrough_triangles.png)", "",
-          f"## (b) LOD against uniform tessellation at equal measured deviation ({result['small']['source']}, "
-          f"delta {result['lod_vs_uniform']['delta']:g})", "",
-          "Every super-surface at one level against the coarsest uniform mesh whose measured deviation is at most the "
-          "level's (both measured by `measured_deviation`; frame time of the whole model in view).", "",
-          md_table(result["lod_vs_uniform"]["matches"],
+          f"## (b) LOD against uniform tessellation and OpenCASCADE at equal measured deviation "
+          f"({result['small']['source']}, delta {b['delta']:g})", "",
+          "Every super-surface at one level against the coarsest uniform mesh and the coarsest OpenCASCADE mesh "
+          "(`BRepMesh_IncrementalMesh`, linear deflections as listed, angular deflection 0.5 rad) whose measured "
+          "deviation is at most the level's (all measured by `measured_deviation`; frame time of the whole model in "
+          "view, flat shaded alike).", "",
+          md_table(b["matches"],
                    [("LOD", "level", "s"), ("deviation", "lod_deviation", "e"), ("triangles", "lod_triangles", "int"),
                     ("frame (ms)", "lod_frame_ms", "f1"), ("uniform", "uniform", "s"),
                     ("deviation", "uniform_deviation", "e"), ("triangles", "uniform_triangles", "int"),
-                    ("frame (ms)", "uniform_frame_ms", "f1"), ("uniform / LOD triangles", "triangle_ratio", "f2")]), "",
-          md_table(result["lod_vs_uniform"]["levels"] + result["lod_vs_uniform"]["uniform"],
+                    ("frame (ms)", "uniform_frame_ms", "f1"), ("uniform / LOD triangles", "uniform_ratio", "f2"),
+                    ("OpenCASCADE", "occ", "s"), ("deviation", "occ_deviation", "e"),
+                    ("triangles", "occ_triangles", "int"), ("frame (ms)", "occ_frame_ms", "f1"),
+                    ("OpenCASCADE / LOD triangles", "occ_ratio", "f2")]), "",
+          md_table(b["levels"] + b["uniform"] + b["occ"],
                    [("mesh", "mesh", "s"), ("proven bound", "bound", "e"), ("measured deviation", "deviation", "e"),
                     ("triangles", "triangles", "int"), ("frame (ms)", "frame_ms", "f1")]), "",
+          "Triangles against measured deviation (left) and the simplified levels of (e) (right):", "",
+          "![meshes](walkthrough_meshes.png)", "",
+          f"## (e) Simplified levels: bounded by delta_l + eps_l ({e['source']}; {e['super_surfaces']} super-surfaces, "
+          f"{e['patches']:,} patches)", "",
+          f"The same model built without and with `Simplifier(share={e['share']:g})` (vtkDecimatePro across patch "
+          "edges inside each super-surface, its border kept, eps_l = share * delta_l, level 0 never simplified; "
+          f"build {e['build_plain_s']:.1f} s against {e['build_simplified_s']:.1f} s). Per level: the proven part "
+          "delta_l, eps_l, the triangles, the largest distance the Simplifier measured (`lod.simplified`, held to "
+          "delta_l + eps_l) and the study's `measured_deviation` of every super-surface at that level "
+          f"({e['samples_per_span']} samples per span).", "",
+          md_table(e["levels"], [("level", "level", "int"), ("delta_l", "delta", "e"), ("eps_l", "eps", "e"),
+                                 ("bound delta_l + eps_l", "bound", "e"), ("triangles plain", "triangles_plain", "int"),
+                                 ("triangles simplified", "triangles_simplified", "int"),
+                                 ("simplified / plain", "ratio", "f2"), ("super-surfaces reduced", "reduced", "s"),
+                                 ("Simplifier measured (max)", "simplifier_measured", "e"),
+                                 ("measured deviation plain", "deviation_plain", "e"),
+                                 ("measured deviation simplified", "deviation_simplified", "e")]), "",
+          "A level kept unsimplified (no decimation within its bound) records its delta_l as the measured distance.",
+          "", f"Fly-through of this model ({result['frames']} frames, the same path and pixel error for both, "
+          f"sequential; {e['repeats']} alternated run(s), means). A simplified level's bound delta_l + eps_l is "
+          "larger, so at the same pixel error the selection may draw a finer level than without simplification:", "",
+          md_table(e["flights"], [("levels of detail", "lod", "s"), ("pixel error", "pixel_error", "f1")] + fly_cols),
+          "",
           f"The hull ({h['source']}) in the headline table: {h['super_surfaces']} super-surfaces.", "",
           f"Run time {result['seconds']:.0f} s.", ""]
     for r in result["vs_delta"]:
         r.pop("per_level", None)
+    for r in e["levels"]:
+        r.pop("reduced", None)
     path = Path(out) / "walkthrough.md"
     path.write_text("\n".join(md))
     return path
@@ -415,9 +381,41 @@ def _thread_note(parts, threads) -> str:
             f"stages they could take off the renderer are this small, and each hand-over would copy the mesh.")
 
 
+def _simplification(cache, s, version, progress, pixel_errors=(1.0, 4.0)) -> dict:
+    """(e): the model ``s["simplify"]`` built without and with a Simplifier, per level and flown through at
+    each of ``pixel_errors`` (runs alternated ``s["repeats"]`` times: the machine is shared)."""
+    from ..nurbs.lod.simplify import Simplifier
+
+    simplifier = Simplifier()
+    kind, n = s["simplify"]
+    model = _model(kind, n)
+    plain, plain_s, patches = _lod(cache, kind, n, s["simplify_delta"], progress=progress, version=version)
+    simple, simple_s, _ = _lod(cache, kind, n, s["simplify_delta"], progress=progress, version=version,
+                               simplify=simplifier)
+    levels = simplification_levels(plain, simple, model, s["simplify_samples"])
+    path = _path(plain, s["frames"])
+    flights = []
+    for pe in pixel_errors:
+        runs = {"plain": [], "simplified": []}
+        for _ in range(s["repeats"]):
+            for name, lod in (("plain", plain), ("simplified", simple)):
+                runs[name].append(_fly(lod, path, pixel_error=pe, threaded=False)[0])
+        for (name, rows), lod in zip(runs.items(), (plain, simple)):
+            row = {k: (float(np.mean([r[k] for r in rows])) if isinstance(v, float) else max(r[k] for r in rows))
+                   for k, v in rows[0].items()}  # means; the counts (frames, mesh age max, new meshes) their largest
+            row["fps"] = 1e3 / row["frame_mean_ms"]
+            flights.append({"lod": f"{name} (bounds {', '.join(f'{x:.3g}' for x in lod.tolerance)})",
+                            "pixel_error": pe, **row})
+    return {"source": model.source, "patches": patches, "super_surfaces": len(plain.supers.members),
+            "delta": s["simplify_delta"], "share": simplifier.share, "samples_per_span": s["simplify_samples"],
+            "build_plain_s": plain_s, "build_simplified_s": simple_s, "repeats": s["repeats"], "levels": levels,
+            "flights": flights}
+
+
 def run_walkthrough_study(out_dir, *, quick=False, progress=True) -> dict:
     """Run the study; returns the dict also written to ``out_dir/walkthrough.json`` (plus ``walkthrough.md`` and
-    the figures ``walkthrough_frames.png``, ``walkthrough_triangles.png``)."""
+    the figures ``walkthrough_frames.png``, ``walkthrough_triangles.png``, ``walkthrough_views.png``,
+    ``walkthrough_meshes.png``)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cache = out / "lod_cache"
@@ -465,7 +463,11 @@ def run_walkthrough_study(out_dir, *, quick=False, progress=True) -> dict:
                                    **row})
     delta_b = s["deltas"][0]
     sl, _, _ = _lod(cache, *s["small"], delta_b, progress=False, version=version)
-    result["lod_vs_uniform"] = {"delta": delta_b, **lod_vs_uniform(sl, small_model)}
+    log("walkthrough", "(b) LOD against uniform tessellation and OpenCASCADE")
+    deflections = occ_deflections(sl.tolerance, s["occ_step"])
+    result["lod_vs_meshes"] = {"delta": delta_b, **lod_vs_meshes(sl, small_model, deflections=deflections)}
+    log("walkthrough", "(e) simplified levels")
+    result["simplification"] = _simplification(cache, s, version, progress)
     result["machine"]["loadavg_end"] = [round(x, 2) for x in os.getloadavg()]
     result["seconds"] = time.perf_counter() - t0
     _figures(out, result)

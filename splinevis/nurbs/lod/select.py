@@ -23,8 +23,10 @@ off the axis of view, ``d`` is the paper's isotropic measure [Kumar1997, sec. 4.
 view it underestimates the error by at most ``1 / cos(theta_max)`` (1.05 for a 30 degree ``fov_y`` at 4:3).
 The coarsest level with ``e_l <= pixel_error`` is the largest ``l`` with ``tol_l <= pixel_error * d / k``,
 ``k = H / (2 tan(fov_y / 2))``: one ``searchsorted`` for all super-surfaces at once. When even level 0 is too
-coarse the super-surface gets level 0 and is counted in ``stats["needs_finer"]`` (the paper then tessellates
-dynamically; :mod:`splinevis.nurbs.program` evaluates per fragment).
+coarse the super-surface gets level 0 and is counted in ``stats["needs_finer"]``; ``stats["finer_steps"]`` tells
+how many finer steps it needs: the smallest ``j`` with ``tol_0 / finer_ratio**j <= pixel_error * d / k``, capped at
+``max_finer`` (``stats["finer_capped"]`` counts where the cap binds, the eye inside the box included), the
+tolerance the dynamic tessellation of :mod:`.dynamic` makes [Kumar1997, sec. 2.2, 4.4].
 
 **The projection from the matrix.** The rows of ``M`` are ``r_i = sum_j P_ij v_j`` with ``v_j`` the
 orthonormal rows of ``V``'s rotation: ``|r_1[:3]| = P_11`` (symmetric frustum) and ``|r_3[:3]| = 1`` for a
@@ -77,7 +79,7 @@ def _box_distance(boxes, eye):
 
 
 def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_back: bool = True, fov_y=None, *,
-                  cull_frustum: bool = True):
+                  cull_frustum: bool = True, finer_ratio: float = 4.0, max_finer: int = 4):
     """A level per super-surface for one view: ``(levels (S,) int, stats)``, ``-1`` where not drawn
     (module docstring) [Kumar1997, sec. 4.4].
 
@@ -100,14 +102,18 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         Vertical field of view in radians (default: from ``view_proj``).
     cull_frustum : bool
         View-frustum culling (off: every super-surface is tested for back-facing and drawn otherwise).
+    finer_ratio, max_finer : float, int
+        Finer step ``j`` has the tolerance ``tol_0 / finer_ratio**j``, ``j <= max_finer`` (``stats["finer_steps"]``).
 
     Returns
     -------
     levels : (S,) int64 array
     stats : dict
         ``visible``, ``culled_frustum``, ``culled_back``, ``needs_finer`` (drawn at level 0 although its
-        projected error exceeds ``pixel_error``), ``per_level`` (drawn count per level, finest first) and
-        ``triangles`` (sum of ``lod.triangles`` of the chosen levels, before the assembly's fans).
+        projected error exceeds ``pixel_error``), ``finer_steps`` ((S,) int: the finer steps each of those needs,
+        0 elsewhere), ``finer_capped`` (how many need more than ``max_finer``), ``per_level`` (drawn count per
+        level, finest first) and ``triangles`` (sum of ``lod.triangles`` of the chosen levels, before the
+        assembly's fans).
 
     Examples
     --------
@@ -125,7 +131,13 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
     >>> levels.tolist(), stats["per_level"], stats["culled_frustum"], stats["triangles"]
     ([1, 2, -1], [0, 1, 1], 1, 44)
 
-    At 10 units one pixel is 0.1 units: level 1 (0.1) fits 1 pixel, level 0 is needed for half a pixel.
+    At 10 units one pixel is 0.1 units: level 1 (0.1) fits 1 pixel, level 0 is needed for half a pixel. At a
+    hundredth of a pixel (0.001 units at 10, 0.1 at 1000) the far one takes level 1 and even level 0 is too
+    coarse for the near one: it needs two finer steps of ratio 4 (0.01 / 16 <= 0.001 < 0.01 / 4).
+
+    >>> levels, stats = select_levels(lod, [0, 0, 0], M, 200, pixel_error=0.01)
+    >>> levels.tolist(), stats["needs_finer"], stats["finer_steps"].tolist()
+    ([0, 1, -1], 1, [2, 0, 0])
     """
     S = int(np.asarray(lod.boxes).shape[0])
     boxes = np.asarray(lod.boxes, dtype=np.float64).reshape(S, 6)
@@ -136,6 +148,8 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         raise ValueError("lod.tolerance must hold at least one level, finest (smallest) first.")
     if pixel_error is not None and not (float(pixel_error) >= 0.0):
         raise ValueError(f"pixel_error must be a non-negative number of pixels or None, got {pixel_error!r}.")
+    if not (float(finer_ratio) > 1.0 and math.isfinite(float(finer_ratio))) or int(max_finer) < 0:
+        raise ValueError(f"finer_ratio must be > 1 and max_finer >= 0, got {finer_ratio!r}, {max_finer!r}.")
     if cull_frustum:
         ids = frustum_cull(lod.bvh, frustum_planes(view_proj))
     else:
@@ -147,7 +161,8 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         culled_back = int(back.sum())
         ids = ids[~back]
     levels = np.full(S, -1, dtype=np.int64)
-    needs_finer = 0
+    needs_finer, finer_capped = 0, 0
+    finer = np.zeros(S, dtype=np.int64)
     if ids.size:
         if pixel_error is None:
             chosen = np.zeros(ids.size, dtype=np.int64)
@@ -162,11 +177,21 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
             fits = np.searchsorted(tol, limit, side="right")  # number of levels with tol_l <= limit
             needs_finer = int((fits == 0).sum())
             chosen = np.maximum(fits - 1, 0)
+            if needs_finer:
+                short = np.flatnonzero(fits == 0)
+                lim = limit[short]
+                with np.errstate(divide="ignore"):  # limit 0 (eye inside the box): infinitely many steps
+                    j = np.ceil(np.log(tol[0] / lim) / math.log(float(finer_ratio)))
+                j = np.where(np.isfinite(j), np.maximum(j, 1.0), np.inf)
+                j = np.where(tol[0] / float(finer_ratio) ** np.minimum(j, 64.0) > lim, j + 1.0, j)  # rounding of log
+                finer_capped = int((j > int(max_finer)).sum())
+                finer[ids[short]] = np.minimum(j, int(max_finer)).astype(np.int64)
         levels[ids] = chosen
     drawn = levels >= 0
     per_level = np.bincount(levels[drawn], minlength=L)
     tri = np.asarray(lod.triangles)
     triangles = int(tri[np.flatnonzero(drawn), levels[drawn]].sum()) if drawn.any() else 0
     stats = {"visible": int(drawn.sum()), "culled_frustum": culled_frustum, "culled_back": culled_back,
-             "needs_finer": needs_finer, "per_level": per_level.tolist(), "triangles": triangles}
+             "needs_finer": needs_finer, "finer_steps": finer, "finer_capped": finer_capped,
+             "per_level": per_level.tolist(), "triangles": triangles}
     return levels, stats
