@@ -2,9 +2,10 @@
 border vertices [Kumar1997, sec. 4.2], so the mesh of a closed B-rep is closed at every level combination.
 
 Two solids are built with OpenCASCADE and written to STEP as CAD systems write them (planes, cylinders), then
-read back (the reader converts the analytic faces to NURBS): a box with a straight cylindrical hole (the planes' trim circles meet the cylinder's natural sides) and a box
+read back (the reader converts the analytic faces to NURBS): a box with a straight cylindrical hole (the planes' trim circles meet the cylinder's natural sides), a box
 with a tilted hole (the planes' trim ellipses meet the cylinder's trim curves, which OpenCASCADE writes as
-degree-8 pcurves and the reader brings to cubics).
+degree-8 pcurves and the reader brings to cubics), and a plate with filleted edges (cylinders and, at the
+corners, spheres with their poles) and six holes.
 """
 
 import numpy as np
@@ -15,6 +16,38 @@ from splinevis.nurbs.lod.levels import assemble, build_lod
 from splinevis.nurbs.trim import inside, trim_pieces
 
 LEVELS = 3
+
+
+def _plate(path):
+    """A plate with every edge filleted (cylinders, spheres with their poles at the corners) and six holes."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    from splinevis.io import read_nurbs
+    from splinevis.io.nurbs_step import _quiet_occ
+
+    _quiet_occ()
+    shape = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 6.0, 4.0, 1.0).Shape()
+    fillet = BRepFilletAPI_MakeFillet(shape)
+    edges = TopExp_Explorer(shape, TopAbs_EDGE)
+    while edges.More():
+        fillet.Add(0.3, TopoDS.Edge(edges.Current()))
+        edges.Next()
+    shape = fillet.Shape()
+    for x in (1.0, 3.0, 5.0):
+        for y in (1.0, 3.0):
+            hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(x, y, -1), gp_Dir(0, 0, 1)), 0.4, 3.0).Shape()
+            shape = BRepAlgoAPI_Cut(shape, hole).Shape()
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    writer.Write(str(path))
+    return read_nurbs(path)
 
 
 def _solid(path, tilted: bool):
@@ -45,6 +78,8 @@ def solids(tmp_path_factory):
     for name, tilted in (("straight", False), ("tilted", True)):
         model = _solid(folder / f"{name}.step", tilted)
         out[name] = (model, build_lod(model, 0.01, levels=LEVELS, progress=False, workers=1))
+    model = _plate(folder / "plate.step")
+    out["plate"] = (model, build_lod(model, 0.005, levels=LEVELS, progress=False, workers=1))
     return out
 
 
@@ -73,7 +108,7 @@ def test_the_reader_brings_high_degree_trim_curves_to_cubics(solids):
             assert (seam | (np.abs(np.abs(z) - 1.0) <= 1e-7)).all()
 
 
-@pytest.mark.parametrize("name", ["straight", "tilted"])
+@pytest.mark.parametrize("name", ["straight", "tilted", "plate"])
 def test_a_trimmed_solid_stays_a_closed_manifold_at_every_level_combination(solids, name):
     _, lod = solids[name]
     assert (lod.status == 1).any()  # trims cut patches
@@ -84,7 +119,7 @@ def test_a_trimmed_solid_stays_a_closed_manifold_at_every_level_combination(soli
         assert counts.min() == 2 and counts.max() == 2  # no crack along trims, no fold
 
 
-@pytest.mark.parametrize("name", ["straight", "tilted"])
+@pytest.mark.parametrize("name", ["straight", "tilted", "plate"])
 def test_the_trimmed_solid_is_within_its_bound(solids, name):
     model, lod = solids[name]
     pieces = trim_pieces(model.trims)
@@ -115,6 +150,24 @@ def test_no_background_pixel_from_inside_a_trimmed_solid(solids, name, focus):
         pl.add_mesh(pv.PolyData(points, np.column_stack([np.full(len(tri), 3), tri]).ravel()), color="white",
                     lighting=False)
         pl.camera_position = [(1.5, -1.5, 0.2), focus, (0.0, 0.0, 1.0)]  # in the material, between hole and wall
+        pl.camera.view_angle = 70.0
+        pl.camera.clipping_range = (1e-3, 20.0)
+        img = pl.screenshot()
+        pl.close()
+        assert (img.sum(axis=-1) == 0).sum() == 0
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("focus", [(5.0, 3.0, 0.5), (0.0, 0.0, 0.2), (3.0, 1.0, 0.9)])
+def test_no_background_pixel_from_inside_the_filleted_plate(solids, focus):
+    _, lod = solids["plate"]
+    for level in list(_combos(lod, count=2)):
+        points, tri, _ = assemble(lod, level)
+        pl = pv.Plotter(off_screen=True, window_size=(200, 150))
+        pl.set_background("black")
+        pl.add_mesh(pv.PolyData(points, np.column_stack([np.full(len(tri), 3), tri]).ravel()), color="white",
+                    lighting=False)
+        pl.camera_position = [(2.0, 2.0, 0.5), focus, (0.0, 0.0, 1.0)]  # in the material, between the holes
         pl.camera.view_angle = 70.0
         pl.camera.clipping_range = (1e-3, 20.0)
         img = pl.screenshot()

@@ -170,7 +170,8 @@ def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rin
     q = uv[bv]
     on_side = (q[:, 0] == 0.0) | (q[:, 0] == 1.0) | (q[:, 1] == 0.0) | (q[:, 1] == 1.0)
     off_line = shapely.distance(shapely.points(q), lines) > 1e-9 if lines is not None else np.ones(len(q), dtype=bool)
-    keep = shapely.intersects_xy(region, q[:, 0], q[:, 1]) & (on_side | off_line)
+    # in the region or on its border (within rounding: the region was mapped to the patch's domain)
+    keep = shapely.dwithin(region, shapely.points(q), 1e-12) & (on_side | off_line)
     base = np.concatenate([np.unique(tri[whole]), bv[keep]])
     ring_pts = np.concatenate(pieces) if pieces else np.zeros((0, 2))
     allowed_t = np.maximum(float(target), tess.bound)

@@ -96,7 +96,9 @@ def _invert_on_face(bs, f, uv0, target, domain, iterations=30):
         Su, Sv = Su / (r[:, 1] - r[:, 0])[:, None], Sv / (r[:, 3] - r[:, 2])[:, None]
         J = np.stack([Su, Sv], axis=-1)  # (K, 3, 2)
         g = np.einsum("kci,kc->ki", J, target - S)
-        H = np.einsum("kci,kcj->kij", J, J) + 1e-300 * np.eye(2)
+        H = np.einsum("kci,kcj->kij", J, J)
+        lam = 1e-12 * np.trace(H, axis1=1, axis2=2) + 1e-300  # damped at poles, where S_u or S_v vanishes
+        H = H + lam[:, None, None] * np.eye(2)
         step = np.linalg.solve(H, g[..., None])[..., 0]
         x = np.column_stack([np.clip(x[:, 0] + step[:, 0], domain[0], domain[1]),
                              np.clip(x[:, 1] + step[:, 1], domain[2], domain[3])])

@@ -231,6 +231,10 @@ def split_segments(bs, f: int, ring, chord=None, rounds: int = 40):
                 cuts.append((s, q))
         pts.extend(q[None] for _, q in sorted(cuts, key=lambda c: c[0]))
     ring = np.concatenate(pts)
+    span = max(float(np.ptp(rect[:, :2])), float(np.ptp(rect[:, 2:])))
+    same = np.linalg.norm(ring - np.roll(ring, -1, axis=0), axis=1) <= 1e-14 * span  # repeated points: one
+    if same.any() and not same.all():
+        ring = ring[~same]
     if chord is None:
         return ring
     from .bezier import locate as _locate
@@ -246,8 +250,13 @@ def split_segments(bs, f: int, ring, chord=None, rounds: int = 40):
         n *= np.where(np.einsum("ki,ki->k", n, 0.5 - st) < 0, -0.5, 0.5)[:, None]
         c = np.clip(st + n, 0.0, 1.0)
         Pw = np.stack([bs.control(int(i)) for i in p])
-        bound = triangle_bounds(Pw, np.stack([la, lb, c], axis=1))
-        split = bound > float(chord)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            bound = triangle_bounds(Pw, np.stack([la, lb, c], axis=1))
+        # segments down to 1e-9 of the domain: shorter ones are left (their chord is the surface to rounding)
+        split = (bound > float(chord)) & (np.linalg.norm(b - a, axis=1) > 1e-9 * span)
+        if ring.shape[0] + int(split.sum()) > 2_000_000:
+            raise RuntimeError(f"surface {f}: splitting a trim polyline to the chord bound {chord:.3g} would pass "
+                               "2,000,000 points; the trim lies where the surface bends too sharply for this delta")
         if not split.any():
             break
         mids = 0.5 * (a + b)
