@@ -184,3 +184,29 @@ def test_interact_ticks_on_the_interactor_timer_and_stops_the_workers():
         w.close()
         pl.off_screen = True
         pl.close()
+
+
+@pytest.mark.gl
+def test_the_close_approach_switches_to_exact_patches_and_back(sphere_lod):
+    """With a CloseUp the fly-through draws the super-surfaces that fill the view with the per-fragment program:
+    none far away, some at the end of the close approach; the log carries the close-up's statistics; closing the
+    walkthrough removes the exact actors."""
+    from splinevis.nurbs.lod.closeup import CloseUp
+
+    far, near = [(0.0, -40.0, 0.0), (0, 0, 0), (0, 0, 1)], [(0.0, -1.4, 0.0), (0, 0, 0), (0, 0, 1)]
+    path = [far] * 3 + [near] * 3 + [far] * 2
+    pl = pv.Plotter(off_screen=True, window_size=(160, 120))
+    cu = CloseUp(max_supers=2)
+    w = Walkthrough(sphere_lod, pl, threaded=False, closeup=cu)
+    frames = w.fly(path, progress=False)
+    assert [f["closeup"] for f in frames] == [0, 0, 0, 2, 2, 2, 0, 0]
+    assert [f["closeup_switch"] for f in frames] == [False, False, False, True, False, False, True, False]
+    assert all("closeup_ms" in f and f["closeup"] <= 2 for f in frames)
+    pl.camera_position = near
+    w.fly([near], progress=False)
+    img = pl.screenshot()
+    assert (img.reshape(-1, 3).std(axis=0) > 0).any()  # a picture, not a blank
+    shown = len(pl.renderer.actors)
+    w.close()
+    assert len(pl.renderer.actors) < shown
+    pl.close()

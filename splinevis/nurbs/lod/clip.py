@@ -23,6 +23,8 @@ keeping shared chains.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .adaptive import Tessellation
@@ -177,7 +179,8 @@ def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rin
     allowed_t = np.maximum(float(target), tess.bound)
     tree = shapely.STRtree(polys[band]) if band.size else None
     extra = np.zeros((0, 2))
-    for _ in range(int(rounds) + 1):
+    refined = retried = 0
+    while True:
         inv, P = _unique_points(np.concatenate([uv[base], ring_pts, extra]))
         gid = np.full(uv.shape[0], -1, dtype=np.int64)
         gid[base] = inv[:base.size]
@@ -196,7 +199,20 @@ def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rin
             edges.append(seg[ok])
         E = np.unique(np.sort(np.concatenate(edges), axis=1), axis=0)
         E = E[E[:, 0] != E[:, 1]]
-        V, T = _cdt(P, E)
+        try:
+            V, T = _cdt(P, E)
+        except RuntimeError as err:  # kept triangles of the tessellation that cross (a sliver folded by rounding)
+            named = [tuple(map(int, m)) for m in re.findall(r"\((\d+), (\d+)\)", str(err))]
+            g = gid[tri[whole]]
+            hit = np.zeros(whole.size, dtype=bool)
+            for a, b in named:
+                hit |= (g == a).any(axis=1) & (g == b).any(axis=1)
+            if not hit.any() or retried >= 64:
+                raise
+            band, whole = np.concatenate([band, whole[hit]]), whole[~hit]  # triangulated anew instead
+            tree = shapely.STRtree(polys[band])
+            retried += 1
+            continue
         c2 = V[T].mean(axis=1)
         T = T[shapely.contains_xy(region, c2[:, 0], c2[:, 1])]
         keys = [tuple(sorted(t)) for t in T.tolist()]
@@ -214,8 +230,9 @@ def clip_tessellation(tess: Tessellation, Pw, region, chains, target: float, rin
             np.maximum.at(best, hit_pt, allowed_t[band[hit_poly]])
             allowed[new] = best
         over = np.flatnonzero(bound > allowed * (1.0 + 1e-9))
-        if over.size == 0:
+        if over.size == 0 or refined >= int(rounds):
             break
+        refined += 1
         extra = np.concatenate([extra, V[T[over]].mean(axis=1)])
     return Tessellation(V, T, bound, dict(tess.limits), bool(tess.converged and over.size == 0))
 

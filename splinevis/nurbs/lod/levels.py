@@ -361,7 +361,7 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     trimmed = bool(bs.trimmed.any())
     if trimmed and not 0.0 < float(trim_share) < 1.0:
         raise ValueError(f"trim_share must lie in (0, 1), got {trim_share!r}.")
-    tol = 1e-6 * bs.size if tol is None else float(tol)
+    tol = 1e-7 * bs.size if tol is None else float(tol)
     delta_trim = float(trim_share) * float(delta) if trimmed else 0.0
     corner_label, corners = _corner_labels(bs, edges)
     chains, births = _edge_chains(bs, edges, deltas - delta_trim, corner_label)

@@ -163,6 +163,10 @@ class Walkthrough:
         tessellation takes CPU from the software rasterizer while refinements are pending (measured in the
         example: 6.3 fps against 18.5 on 64 teapots at 1 px), so the static pipeline's numbers stay as they were
         unless it is asked for.
+    closeup : CloseUp, optional
+        Super-surfaces that fill the screen drawn exactly by the per-fragment program (:mod:`.closeup`), their
+        mesh kept as a backstop; its ``update`` runs on the renderer's thread each frame and its statistics join
+        the frame log. Off by default: an exact close-up costs about a second a frame on this CPU renderer.
 
     Examples
     --------
@@ -184,7 +188,7 @@ class Walkthrough:
     """
 
     def __init__(self, lod, plotter, threaded: bool = True, pixel_error=1.0, *, cull_frustum: bool = True,
-                 cull_back: bool = True, assemble=None, color: str = "tan", dynamic=False):
+                 cull_back: bool = True, assemble=None, color: str = "tan", dynamic=False, closeup=None):
         import pyvista as pv
 
         from .dynamic import Refiner
@@ -210,6 +214,9 @@ class Walkthrough:
         self.actor = plotter.add_mesh(self.mesh, color=color, reset_camera=False)
         if getattr(lod, "normals", None) is not None:  # the surface's exact vertex normals: smooth shading
             self.actor.prop.interpolation = "phong"
+        self.closeup = closeup
+        if closeup is not None:
+            closeup.attach(plotter, lod, self.actor)
         self._points = None  # the points array the actor shows
         self._shown_cells = None
         self._camera = None  # (frame, eye, view_proj, height)
@@ -383,6 +390,7 @@ class Walkthrough:
                 record = self._mesh
                 t1 = time.perf_counter()
                 new = self._show(record)
+                cu = self.closeup.update(camera, record[4]) if self.closeup is not None else {}
                 t2 = time.perf_counter()
                 self._render()
                 t3 = time.perf_counter()
@@ -396,7 +404,7 @@ class Walkthrough:
                             "upload_ms": 1e3 * (t2 - t1), "render_ms": 1e3 * (t3 - t2),
                             "refined": dyn["refined"], "refined_triangles": dyn["refined_triangles"],
                             "tessellate_ms": t_ms, "finer_pending": dyn["pending"],
-                            "finer_capped": dyn["capped"]})
+                            "finer_capped": dyn["capped"], **cu})
         finally:
             self._halt()
         if self._error is not None:
@@ -479,6 +487,8 @@ class Walkthrough:
         if self._error is not None:
             raise self._error
         new = self._show(self._mesh)
+        if self.closeup is not None and self._camera is not None:
+            new = self.closeup.update(self._camera, self._mesh[4])["closeup_switch"] or new
         if new:
             self._render()
         return new
@@ -509,6 +519,8 @@ class Walkthrough:
         >>> pl.close()
         """
         self._halt()
+        if self.closeup is not None:
+            self.closeup.detach()
         if self._error is not None:
             error, self._error = self._error, None
             raise error

@@ -186,8 +186,6 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
     >>> s.matched["points"], s.stitched
     (0, set())
     """
-    from scipy.spatial import cKDTree
-
     uf = _Find()
     node_edge, node_point, node_patch, node_uv = [], [], [], []
 
@@ -245,17 +243,30 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
         ok = d[np.arange(cand.size), j] <= slack
         return cand[ok], j[ok], s[np.arange(cand.size), j][ok]
 
-    def tree_of(X):
-        return cKDTree(np.asarray(X)) if len(X) else None
+    # which borders may meet: boxes (grown by the slack) that overlap, found in chunks (no all-pairs loop)
+    curves = [("r", f, r) for f, F in faces.items() for r in range(len(F["rings"]))] + [("e", e, 0) for e in ed]
+    pts = [np.asarray(faces[a]["rings"][b]["X"]) if kind == "r" else np.asarray(ed[a]["X"]) for kind, a, b in curves]
+    lo = np.array([p.min(axis=0) for p in pts]).reshape(-1, 3) - slack
+    hi = np.array([p.max(axis=0) for p in pts]).reshape(-1, 3) + slack
+    owner = np.array([a if kind == "r" else ed[a]["face"] for kind, a, _ in curves], dtype=np.int64)
+    meets = [[] for _ in curves]
+    for a in range(0, len(curves), 512):
+        ov = ((lo[a:a + 512, None, :] <= hi[None, :, :]) & (hi[a:a + 512, None, :] >= lo[None, :, :])).all(axis=2)
+        ov &= owner[a:a + 512, None] != owner[None, :]  # other surfaces only
+        for i, j in zip(*np.nonzero(ov)):
+            meets[a + i].append(j)
+    index = {c: n for n, c in enumerate(curves)}
+
+    def partners(kind, a, b, want):
+        return [curves[j] for j in meets[index[(kind, a, b)]] if curves[j][0] == want]
 
     # 1. trim vertices onto open edges and onto other surfaces' trims
     for f, F in faces.items():
-        for R in F["rings"]:
+        for r, R in enumerate(F["rings"]):
             P = np.asarray(R["X"])
             free = np.flatnonzero(R["free"])
-            for e, E in ed.items():
-                if E["face"] == f:
-                    continue
+            for _, e, _ in partners("r", f, r, "e"):
+                E = ed[e]
                 k, j, s = near(P[free], E["X"], closed=False)
                 if k.size == 0:
                     continue
@@ -267,46 +278,44 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
                         E["insert"].append((float(tt), R["nodes"][kk]))
                         stitched.add(e)
                         matched += 1
-            for g_, G in faces.items():
-                if g_ == f:
+            for _, g_, si in partners("r", f, r, "r"):
+                G = faces[g_]
+                S = G["rings"][si]
+                Q = np.asarray(S["X"])
+                k, j, s = near(P[free], Q, closed=True)
+                if k.size == 0:
                     continue
-                for S in G["rings"]:
-                    Q = np.asarray(S["X"])
-                    k, j, s = near(P[free], Q, closed=True)
-                    if k.size == 0:
-                        continue
-                    k = free[k]
-                    segs = np.asarray(S["uv"])
-                    ok_seg = S["free_seg"][j]
-                    k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
-                    x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
-                    x, gap = _invert_on_face(bs, g_, x0, P[k], G["dom"])
-                    off = _polyline_gap(x, segs, j)
-                    for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
-                        if gg <= tol and oo <= 2.0 * G["h"] + 1e-12:
-                            S["insert"].append((int(jj), tuple(xx), R["nodes"][kk], P[kk]))
-                            matched += 1
+                k = free[k]
+                segs = np.asarray(S["uv"])
+                ok_seg = S["free_seg"][j]
+                k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
+                x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
+                x, gap = _invert_on_face(bs, g_, x0, P[k], G["dom"])
+                off = _polyline_gap(x, segs, j)
+                for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
+                    if gg <= tol and oo <= 2.0 * G["h"] + 1e-12:
+                        S["insert"].append((int(jj), tuple(xx), R["nodes"][kk], P[kk]))
+                        matched += 1
     # 2. open edges' chain points onto trims
     for e, E in ed.items():
         Pe = np.asarray(E["X"])
-        for f, F in faces.items():
-            if F is None or E["face"] == f:
+        for _, f, ri in partners("e", e, 0, "r"):
+            F = faces[f]
+            R = F["rings"][ri]
+            segs = np.asarray(R["uv"])
+            k, j, s = near(Pe, R["X"], closed=True)
+            if k.size == 0:
                 continue
-            for R in F["rings"]:
-                segs = np.asarray(R["uv"])
-                k, j, s = near(Pe, R["X"], closed=True)
-                if k.size == 0:
-                    continue
-                ok_seg = R["free_seg"][j]
-                k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
-                x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
-                x, gap = _invert_on_face(bs, f, x0, Pe[k], F["dom"])
-                off = _polyline_gap(x, segs, j)
-                for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
-                    if gg <= tol and oo <= 2.0 * F["h"] + 1e-12:
-                        R["insert"].append((int(jj), tuple(xx), E["nodes"][kk], Pe[kk]))
-                        stitched.add(e)
-                        matched += 1
+            ok_seg = R["free_seg"][j]
+            k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
+            x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
+            x, gap = _invert_on_face(bs, f, x0, Pe[k], F["dom"])
+            off = _polyline_gap(x, segs, j)
+            for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
+                if gg <= tol and oo <= 2.0 * F["h"] + 1e-12:
+                    R["insert"].append((int(jj), tuple(xx), E["nodes"][kk], Pe[kk]))
+                    stitched.add(e)
+                    matched += 1
     # 3. apply: edges gain parameters (a point within tol of a chain point is that point), rings gain points
     edge_t = {}
     for e, E in ed.items():
@@ -333,28 +342,43 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
         rs, ns = [], []
         for R in F["rings"]:
             uv, nodes, X = list(R["uv"]), list(R["nodes"]), np.asarray(R["X"])
-            extra = {}
+            ring = np.asarray(uv, dtype=np.float64)
+            seg = np.roll(ring, -1, axis=0) - ring
+            cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(seg, axis=1))])
+            # every point at its place along the polyline: arclength of its projection on the nearest of the
+            # segments around the one it was matched on (sorting by it: no zigzag)
+            keys = [(float(cum[k]), 0, k) for k in range(len(uv))]
+            extra = []
             for jj, xx, other, p in R["insert"]:
                 d = np.linalg.norm(X - p, axis=1)
                 if d.min() <= tol:  # the ring already has this point
                     uf.union(nodes[int(np.argmin(d))], other)
                     continue
-                extra.setdefault(jj, []).append((xx, other, p))
+                x = np.asarray(xx)
+                best = None
+                for j in ((jj - 1) % len(uv), jj, (jj + 1) % len(uv)):
+                    L2 = float(seg[j] @ seg[j])
+                    t = min(max(float((x - ring[j]) @ seg[j]) / L2, 0.0), 1.0) if L2 > 0 else 0.0
+                    dist = float(np.linalg.norm(ring[j] + t * seg[j] - x))
+                    if best is None or dist < best[0]:
+                        best = (dist, float(cum[j] + t * (cum[j + 1] - cum[j])))
+                keys.append((best[1], 1, len(extra)))
+                extra.append((xx, other, p))
             new_uv, new_nodes = [], []
-            for jj in range(len(uv)):
-                new_uv.append(uv[jj])
-                new_nodes.append(nodes[jj])
-                if jj in extra:
-                    a = np.asarray(uv[jj])
-                    for xx, other, p in sorted(extra[jj], key=lambda q: float(np.linalg.norm(np.asarray(q[0]) - a))):
-                        if np.linalg.norm(np.asarray(xx) - np.asarray(new_uv[-1])) == 0.0:
-                            uf.union(new_nodes[-1], other)
-                            continue
-                        _, pp, st = _face_points(bs, f, np.asarray([xx]))
-                        n = new_node(point=p, patch=int(pp[0]), uv=st[0])
-                        uf.union(n, other)
-                        new_uv.append(xx)
-                        new_nodes.append(n)
+            for _, kind, k in sorted(keys):
+                if kind == 0:
+                    new_uv.append(uv[k])
+                    new_nodes.append(nodes[k])
+                    continue
+                xx, other, p = extra[k]
+                if new_uv and np.linalg.norm(np.asarray(xx) - np.asarray(new_uv[-1])) == 0.0:
+                    uf.union(new_nodes[-1], other)
+                    continue
+                _, pp, st = _face_points(bs, f, np.asarray([xx]))
+                n = new_node(point=p, patch=int(pp[0]), uv=st[0])
+                uf.union(n, other)
+                new_uv.append(xx)
+                new_nodes.append(n)
             rs.append(np.asarray(new_uv, dtype=np.float64))
             ns.append(np.asarray(new_nodes, dtype=np.int64))
         out_rings[f] = (rs, F["h"])
