@@ -354,14 +354,15 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     if int(levels) < 1 or not ratio > 1:
         raise ValueError(f"levels must be >= 1 and ratio > 1, got levels={levels!r}, ratio={ratio!r}.")
     bs = bezier_set(model)
-    edges = find_edges(bs)
-    axis, half = _patch_cones(bs)
-    supers = grow_super_surfaces((axis, half), _neighbours(edges), float(alpha))
-    deltas = float(delta) * float(ratio) ** np.arange(int(levels))
     trimmed = bool(bs.trimmed.any())
     if trimmed and not 0.0 < float(trim_share) < 1.0:
         raise ValueError(f"trim_share must lie in (0, 1), got {trim_share!r}.")
     tol = 1e-7 * bs.size if tol is None else float(tol)
+    # a trimmed model comes from a CAD file: its surfaces' shared sides agree to the file's tolerance only
+    edges = find_edges(bs, tol=tol) if trimmed else find_edges(bs)
+    axis, half = _patch_cones(bs)
+    supers = grow_super_surfaces((axis, half), _neighbours(edges), float(alpha))
+    deltas = float(delta) * float(ratio) ** np.arange(int(levels))
     delta_trim = float(trim_share) * float(delta) if trimmed else 0.0
     corner_label, corners = _corner_labels(bs, edges)
     chains, births = _edge_chains(bs, edges, deltas - delta_trim, corner_label)

@@ -207,21 +207,29 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
             nodes = [new_node(point=X[k], patch=int(p[k]), uv=st[k]) for k in range(len(ring))]
             nxt = np.roll(ring, -1, axis=0)
             along = np.zeros(len(ring), dtype=bool)  # segment k (k -> k + 1) lies on the domain's border
+            near = 1e-11 * max(dom[1] - dom[0], dom[3] - dom[2])  # as ring_pieces of .clip: a side within rounding
             for axis, value in ((0, dom[0]), (0, dom[1]), (1, dom[2]), (1, dom[3])):
-                along |= (ring[:, axis] == value) & (nxt[:, axis] == value)
+                along |= (np.abs(ring[:, axis] - value) <= near) & (np.abs(nxt[:, axis] - value) <= near)
             free_seg = ~along
             out.append({"uv": [tuple(q) for q in ring], "X": [x for x in X], "nodes": nodes,
                         "free": free_seg | np.roll(free_seg, 1), "free_seg": free_seg, "insert": []})
         faces[f] = {"rings": out, "h": h, "dom": dom}
     # open edges: chain nodes
     ed = {}
-    for e in open_edges(edges):
+    # the edges a trim may lie along: open ones, and those with a side on a trimmed surface (its trim may run just
+    # inside that side, so the side is not drawn there while its neighbour's is)
+    n_sides = np.diff(edges.offsets)[:len(edges)]
+    side_patch = edges.members // 4
+    trimmed_side = np.zeros(len(edges), dtype=bool)
+    np.logical_or.at(trimmed_side, np.repeat(np.arange(len(edges)), n_sides), bs.trimmed[side_patch])
+    for e in np.flatnonzero((n_sides == 1) | trimmed_side):
         side = int(edges.edge_side[e])
         i, k = divmod(side, 4)
         net = side_net(bs.control(i), k)
         t = np.asarray(chains[e], dtype=np.float64)
         X = curve_points(net, t)
-        ed[int(e)] = {"face": int(bs.parent[i]), "net": net, "t": list(t), "X": list(X),
+        faces_of = set(bs.parent[side_patch[edges.offsets[e]:edges.offsets[e + 1]]].tolist())
+        ed[int(e)] = {"faces": faces_of, "net": net, "t": list(t), "X": list(X),
                       "nodes": [new_node(edge=(int(e), n)) for n in range(t.size)], "insert": []}
     slack = float(delta) + float(tol)
     matched = 0
@@ -248,7 +256,7 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
     pts = [np.asarray(faces[a]["rings"][b]["X"]) if kind == "r" else np.asarray(ed[a]["X"]) for kind, a, b in curves]
     lo = np.array([p.min(axis=0) for p in pts]).reshape(-1, 3) - slack
     hi = np.array([p.max(axis=0) for p in pts]).reshape(-1, 3) + slack
-    owner = np.array([a if kind == "r" else ed[a]["face"] for kind, a, _ in curves], dtype=np.int64)
+    owner = np.array([a if kind == "r" else -1 for kind, a, _ in curves], dtype=np.int64)  # edges: any face
     meets = [[] for _ in curves]
     for a in range(0, len(curves), 512):
         ov = ((lo[a:a + 512, None, :] <= hi[None, :, :]) & (hi[a:a + 512, None, :] >= lo[None, :, :])).all(axis=2)
@@ -267,6 +275,8 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
             free = np.flatnonzero(R["free"])
             for _, e, _ in partners("r", f, r, "e"):
                 E = ed[e]
+                if E["faces"] == {f}:  # an edge of this surface alone
+                    continue
                 k, j, s = near(P[free], E["X"], closed=False)
                 if k.size == 0:
                     continue
@@ -300,6 +310,8 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
     for e, E in ed.items():
         Pe = np.asarray(E["X"])
         for _, f, ri in partners("e", e, 0, "r"):
+            if E["faces"] == {f}:
+                continue
             F = faces[f]
             R = F["rings"][ri]
             segs = np.asarray(R["uv"])

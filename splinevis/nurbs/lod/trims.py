@@ -193,9 +193,24 @@ def face_rings(bs, trims, delta_trim: float, chord=None) -> dict:
         ids = np.flatnonzero(bs.parent == f)
         lip = max(gradient_bound(bs.control(int(i)), bs.rect[i]) for i in ids)
         h = float(delta_trim) / max(lip, np.finfo(float).tiny)
-        rings = [split_segments(bs, int(f), r, chord) for r in trim_polylines(trims[int(f)], h)]
+        # polylines within 0.999 h of their curves, then points within 0.001 h of the domain's border put on it:
+        # files give a loop along a surface's own border a hair inside it (OpenCASCADE: 1e-13 to 1e-10), and such
+        # a loop is the border (drawn by the sides' chains, shared with the neighbour), not a trim
+        dom = (bs.rect[ids, 0].min(), bs.rect[ids, 1].max(), bs.rect[ids, 2].min(), bs.rect[ids, 3].max())
+        rings = [split_segments(bs, int(f), _snap_border(r, dom, 1e-3 * h), chord)
+                 for r in trim_polylines(trims[int(f)], 0.999 * h)]
         out[int(f)] = (rings, h)
     return out
+
+
+def _snap_border(ring, dom, near):
+    """Coordinates of ``ring`` within ``near`` of the domain ``dom`` (u0, u1, v0, v1)'s border set onto it."""
+    ring = np.array(ring, dtype=np.float64)
+    for axis, value in ((0, dom[0]), (0, dom[1]), (1, dom[2]), (1, dom[3])):
+        on = np.abs(ring[:, axis] - value) <= near
+        ring[on, axis] = value
+    keep = np.linalg.norm(ring - np.roll(ring, -1, axis=0), axis=1) > 0
+    return ring[keep] if keep.any() else ring
 
 
 def split_segments(bs, f: int, ring, chord=None, rounds: int = 40):
