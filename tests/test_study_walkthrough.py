@@ -15,7 +15,7 @@ from splinevis.studies.nurbs_occ import occ_available
 TINY = {"main": ("teapot", 4), "main_delta": 0.1, "small": ("teapot", 1), "deltas": (0.1, 0.3),
         "hull": ("hull", 60), "hull_delta": 0.02, "frames": 8, "pixel_errors": (1.0, 4.0),
         "simplify": ("hull_noportholes", 300), "simplify_delta": 0.01, "simplify_samples": 12, "repeats": 1,
-        "occ_step": 4.0}
+        "occ_step": 4.0, "cad_copies": 1, "cad_delta": 0.02}
 
 
 @pytest.fixture(scope="module")
@@ -38,6 +38,16 @@ def test_json_and_markdown_have_the_new_sections(run):
                                     "occ_triangles", "occ_frame_ms", "occ_ratio"}
     assert set(e) >= {"source", "levels", "flights", "share", "build_plain_s", "build_simplified_s"}
     assert [r["level"] for r in e["levels"]] == [0, 1, 2, 3]
+    # (f): the three configurations; only the last draws exact close-ups, and it does on the close approach
+    f = data["finer"]["rows"]
+    assert [r["configuration"] for r in f] == ["static levels", "+ dynamic tessellation", "+ exact close-ups"]
+    assert f[0]["refined"] == 0 and f[0]["closeup_frames"] == 0 and f[1]["closeup_frames"] == 0
+    assert f[2]["closeup_frames"] > 0
+    # (g): the plate through STEP is a closed solid at level 0 and at mixed levels
+    g = data["cad"]
+    assert g["available"] and g["faces"] == 32 and g["open_edges_level0"] == 0 and g["open_edges_mixed_max"] == 0
+    md = (out / "walkthrough.md").read_text()
+    assert "## (f) Finer than level 0" in md and "## (g) A trimmed CAD assembly through STEP" in md
     assert [(f["lod"].split()[0], f["pixel_error"]) for f in e["flights"]] == [
         ("plain", 1.0), ("simplified", 1.0), ("plain", 4.0), ("simplified", 4.0)]
     assert "0 portholes" in e["source"]

@@ -20,6 +20,8 @@ threaded pipeline [Kumar1997], measured on this machine (Mesa llvmpipe, no GPU).
   portholes built without and with :class:`splinevis.nurbs.lod.simplify.Simplifier`; per level the proven part
   ``delta_l``, ``eps_l``, the triangles, the Simplifier's measured distance against ``delta_l + eps_l`` and
   the study's measured deviation; and the fly-through of both (same path, same pixel error).
+* **(f) Finer than level 0** and **(g) a trimmed CAD assembly through STEP**:
+  :mod:`splinevis.studies.walkthrough_finer`.
 
 Frames are 800x600 without multisampling (llvmpipe's 4x multisampling costs ~70 ms a frame alone and is
 the same for every configuration). Level-of-detail models are cached as pickles ``(lod, build seconds)`` in
@@ -41,6 +43,7 @@ from .report import (clean, log, md_table, paper_columns, paper_table, progress_
                      write_json)
 from .walkthrough_compare import (WINDOW, lod_bounds, lod_vs_meshes, measured_deviation, occ_deflections, plotter,
                                   simplification_levels)
+from .walkthrough_finer import cad_assembly, finer_than_level0
 
 __all__ = ["run_walkthrough_study", "measured_deviation", "code_version", "PAPER_ROWS"]
 
@@ -66,11 +69,11 @@ def _settings(quick):
         return {"main": ("teapot", 63), "main_delta": 0.1, "small": ("teapot", 2), "deltas": (0.03, 0.1, 0.3),
                 "hull": ("hull", 300), "hull_delta": 0.01, "frames": 40, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0),
                 "simplify": ("hull_noportholes", 300), "simplify_delta": 0.01, "simplify_samples": 12, "repeats": 1,
-                "occ_step": 4.0}
+                "occ_step": 4.0, "cad_copies": 1, "cad_delta": 0.01}
     return {"main": ("teapot", 1250), "main_delta": 0.1, "small": ("teapot", 16), "deltas": (0.01, 0.03, 0.1, 0.3),
             "hull": ("hull", 10000), "hull_delta": 0.005, "frames": 120, "pixel_errors": (0.5, 1.0, 2.0, 4.0, 8.0),
             "simplify": ("hull_noportholes", 10000), "simplify_delta": 0.005, "simplify_samples": 8, "repeats": 2,
-            "occ_step": np.sqrt(2.0)}
+            "occ_step": np.sqrt(2.0), "cad_copies": 16, "cad_delta": 0.005}
 
 
 def _model(kind, n):
@@ -359,8 +362,9 @@ def write_markdown(out, result) -> Path:
           "larger, so at the same pixel error the selection may draw a finer level than without simplification:", "",
           md_table(e["flights"], [("levels of detail", "lod", "s"), ("pixel error", "pixel_error", "f1")] + fly_cols),
           "",
-          f"The hull ({h['source']}) in the headline table: {h['super_surfaces']} super-surfaces.", "",
-          f"Run time {result['seconds']:.0f} s.", ""]
+          f"The hull ({h['source']}) in the headline table: {h['super_surfaces']} super-surfaces.", ""]
+    md += _finer_markdown(result)
+    md += [f"Run time {result['seconds']:.0f} s.", ""]
     for r in result["vs_delta"]:
         r.pop("per_level", None)
     for r in e["levels"]:
@@ -368,6 +372,39 @@ def write_markdown(out, result) -> Path:
     path = Path(out) / "walkthrough.md"
     path.write_text("\n".join(md))
     return path
+
+
+def _finer_markdown(result) -> list:
+    f, c = result["finer"], result["cad"]
+    md = [f"## (f) Finer than level 0 ({f['source']}, delta {f['delta']:g}, 1 px, threaded)", "",
+          "The close approach ends a few percent of the model's size from a teapot, nearer than level 0's bound allows "
+          "at one pixel. Static levels draw level 0 there; dynamic tessellation refines those super-surfaces in the "
+          "mesh worker (the renderer draws what is ready: 'waiting' counts the rest); exact close-ups draw the "
+          "super-surfaces that fill the view with the per-fragment program.", "",
+          md_table(f["rows"], [("configuration", "configuration", "s"), ("fps", "fps", "f1"),
+                               ("frame mean (ms)", "frame_mean_ms", "f1"), ("frame max (ms)", "frame_max_ms", "f1"),
+                               ("triangles (mean)", "triangles_mean", "int"),
+                               ("wanted finer (mean)", "needs_finer", "f1"), ("refined (mean)", "refined", "f1"),
+                               ("waiting (mean)", "pending", "f1"), ("mesh age mean / max", "age", "s"),
+                               ("frames with exact close-ups", "closeup_frames", "int"),
+                               ("exact super-surfaces (max)", "closeup_max", "int")]), ""]
+    if not c.get("available"):
+        return md + ["## (g) A trimmed CAD assembly through STEP", "", c.get("note", "not run"), ""]
+    c["age"] = f"{c['mesh_age_mean']:.2f} / {c['mesh_age_max']}"
+    return md + ["## (g) A trimmed CAD assembly through STEP", "",
+                 f"{c['copies']} plate(s) with filleted edges and six holes each (planes, cylinders, corner spheres; "
+                 f"{c['faces']:,} trimmed faces, {c['patches']:,} Bezier patches, {c['super_surfaces']:,} "
+                 f"super-surfaces), written by OpenCASCADE and read back in {c['read_s']:.1f} s ({c['source']}); "
+                 "levels of detail at "
+                 f"delta {c['delta']:g} built in {c['build_s']:.1f} s (trims cut, faces stitched along their trims). "
+                 f"Triangles per level: {' / '.join(f'{x:,}' for x in c['triangles_per_level'])}.", "",
+                 f"Open mesh edges (a closed solid has none): {c['open_edges_level0']:,} of the "
+                 f"{c['triangles_level0']:,}-triangle level 0, at most {c['open_edges_mixed_max']:,} over "
+                 f"{c['combos']} random level combinations.", "",
+                 md_table([c], [("fps", "fps", "f1"), ("frame mean (ms)", "frame_mean_ms", "f1"),
+                                ("triangles (mean)", "triangles_mean", "int"),
+                                ("visible super-surfaces", "visible_mean", "f1"), ("mesh age mean / max", "age", "s")]),
+                 ""]
 
 
 def _thread_note(parts, threads) -> str:
@@ -466,8 +503,13 @@ def run_walkthrough_study(out_dir, *, quick=False, progress=True) -> dict:
     log("walkthrough", "(b) LOD against uniform tessellation and OpenCASCADE")
     deflections = occ_deflections(sl.tolerance, s["occ_step"])
     result["lod_vs_meshes"] = {"delta": delta_b, **lod_vs_meshes(sl, small_model, deflections=deflections)}
+    log("walkthrough", "(f) finer than level 0: dynamic tessellation, exact close-ups")
+    result["finer"] = {"source": small_model.source, "delta": delta_b,
+                       "rows": finer_than_level0(sl, _path(sl, s["frames"]), _fly)}
     log("walkthrough", "(e) simplified levels")
     result["simplification"] = _simplification(cache, s, version, progress)
+    log("walkthrough", "(g) a trimmed CAD assembly through STEP")
+    result["cad"] = cad_assembly(out, s["cad_copies"], s["cad_delta"], lambda lod: _path(lod, s["frames"]), _fly)
     result["machine"]["loadavg_end"] = [round(x, 2) for x in os.getloadavg()]
     result["seconds"] = time.perf_counter() - t0
     _figures(out, result)
