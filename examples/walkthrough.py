@@ -1,6 +1,6 @@
 """Fly through a large NURBS model with levels of detail [Kumar1997]: frames, triangles and frame times.
 
-    python examples/walkthrough.py [MODEL_FILE_OR_TEAPOT_COUNT] [OUT_DIR] [--window] [--static]
+    python examples/walkthrough.py [MODEL_FILE_OR_TEAPOT_COUNT] [OUT_DIR] [--window] [--static] [--exact]
 
 MODEL_FILE_OR_TEAPOT_COUNT is a NURBS file (.3dm, .igs, .step, .g2, .json, .bpt) or a number of Newell teapots
 on a grid (default 64: 2,048 patches). The model is cut into Bezier patches, grouped into super-surfaces and
@@ -10,7 +10,8 @@ screen-space error picks, culled by view frustum and back-patch tests, built by 
 renderer draws the previous one; where even the finest level is too coarse for the view, the mesh worker
 tessellates finer on demand (dynamic tessellation; ``--static`` turns it off). Writes ``OUT_DIR/frame_0000.png``
 ..., ``OUT_DIR/frames.csv`` (per-frame log: frame time, triangles, visible and refined super-surfaces, stage
-times) and ``OUT_DIR/summary.png`` (four frames).
+times) and ``OUT_DIR/summary.png`` (four frames). With ``--exact`` the super-surfaces that fill the view are drawn
+exactly by the per-fragment NURBS program (about a second a frame on a CPU renderer), the rest as meshes.
 
 With ``--window`` and a display (``DISPLAY`` set) a window opens instead: fly with the mouse (VTK's trackball
 camera: left drag rotates, right drag or the wheel zooms, middle drag pans); the workers follow your camera and
@@ -41,7 +42,7 @@ def load(arg):
     return teapot_field(int(arg or 64))
 
 
-def main(arg="", out="walkthrough_out", window=False, frames=48, size=(800, 600), dynamic=True):
+def main(arg="", out="walkthrough_out", window=False, frames=48, size=(800, 600), dynamic=True, exact=False):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     model = load(arg)
@@ -55,7 +56,10 @@ def main(arg="", out="walkthrough_out", window=False, frames=48, size=(800, 600)
               f"instead (frames in {out}).", file=sys.stderr)
     pl = pv.Plotter(off_screen=not on_screen, window_size=size)
     pl.set_background("white")
-    walk = Walkthrough(lod, pl, threaded=True, pixel_error=1.0, dynamic=dynamic)
+    if exact:
+        from splinevis.nurbs.lod.closeup import CloseUp
+    walk = Walkthrough(lod, pl, threaded=True, pixel_error=1.0, dynamic=dynamic,
+                       closeup=CloseUp(pixel_error=1.0) if exact else None)
     if on_screen:
         pl.camera_position = camera_path(model.bounds(), 2)[0]
         print("Fly with the mouse; close the window to end.")
@@ -83,6 +87,6 @@ def main(arg="", out="walkthrough_out", window=False, frames=48, size=(800, 600)
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a not in ("--window", "--static")]
+    args = [a for a in sys.argv[1:] if a not in ("--window", "--static", "--exact")]
     main(args[0] if args else "", args[1] if len(args) > 1 else "walkthrough_out", window="--window" in sys.argv,
-         dynamic="--static" not in sys.argv)
+         dynamic="--static" not in sys.argv, exact="--exact" in sys.argv)
