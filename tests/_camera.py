@@ -28,3 +28,20 @@ def perspective(fov_y, aspect, near, far):
     P[2, 2], P[2, 3] = -(far + near) / (far - near), -2.0 * far * near / (far - near)
     P[3, 2] = -1.0
     return P
+
+
+def background_from_inside(points, tri, eye, focus, view_angle=60.0, far=10.0, size=(200, 150)) -> int:
+    """How many pixels of background a camera at ``eye`` looking at ``focus`` (z up) sees around the mesh
+    ``points, tri`` (drawn white and unlit on black): from inside a closed mesh, every pixel is a crack."""
+    import pyvista as pv
+
+    pl = pv.Plotter(off_screen=True, window_size=size)
+    pl.set_background("black")
+    pl.add_mesh(pv.PolyData(points, np.column_stack([np.full(len(tri), 3), tri]).ravel()), color="white",
+                lighting=False)
+    pl.camera_position = [tuple(eye), tuple(focus), (0.0, 0.0, 1.0)]
+    pl.camera.view_angle = view_angle
+    pl.camera.clipping_range = (1e-3, far)
+    img = pl.screenshot()
+    pl.close()
+    return int((img.sum(axis=-1) == 0).sum())

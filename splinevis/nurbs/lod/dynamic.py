@@ -51,7 +51,7 @@ import numpy as np
 
 from .adaptive import _check_chains, _curve_chains, _tessellate
 from .bounds import curve_points, side_net
-from .levels import _SIDE_ENDS, _between, _corner_labels, _fan_rows, _patch_finish, _split_side, vertex_normals
+from .levels import _SIDE_ENDS, _between, _corner_labels, _fan_rows, _fan_split, _patch_finish, vertex_normals
 from .select import _box_distance
 
 __all__ = ["Refiner"]
@@ -417,17 +417,9 @@ class Refiner:
             if fans.size:
                 need = edge_rank[fans[:, 1]] < r
                 if need.any():
-                    rows = fans[need]
-                    keep = np.ones(tri.shape[0], dtype=bool)
-                    extra = []
-                    for t in np.unique(rows[:, 0]):
-                        pieces = [tuple(tri[t])]
-                        for _, eid, a, b, _c in rows[rows[:, 0] == t]:
-                            pieces = _split_side(pieces, a, b, self._between(int(eid), a, b, int(edge_rank[eid])))
-                        keep[t] = False
-                        extra.append(np.array(pieces, dtype=np.int64))
-                        fanned += 1
-                    tri = np.concatenate([tri[keep]] + extra)
+                    tri, k = _fan_split(tri, fans[need],
+                                        lambda eid, a, b: self._between(eid, a, b, int(edge_rank[eid])))
+                    fanned += k
             if r < 0:
                 refined_tri += tri.shape[0]
             out.append(tri)

@@ -497,6 +497,21 @@ def _split_side(pieces, a, b, inner):
     raise RuntimeError(f"no piece holds the side {a}-{b}")
 
 
+def _fan_split(tri, rows, between) -> tuple:
+    """``tri`` with each triangle of ``rows`` (fan rows: triangle, edge, a, b, c) split into fans through
+    ``between(edge, a, b)``, the finer chain's points on its side ``a b``; returns (triangles, count split)."""
+    keep = np.ones(tri.shape[0], dtype=bool)
+    extra = []
+    split = np.unique(rows[:, 0])
+    for t in split:
+        pieces = [tuple(tri[t])]
+        for _, eid, a, b, _c in rows[rows[:, 0] == t]:
+            pieces = _split_side(pieces, a, b, between(int(eid), a, b))
+        keep[t] = False
+        extra.append(np.array(pieces, dtype=np.int64))
+    return np.concatenate([tri[keep]] + extra), int(split.size)
+
+
 def assemble(lod: LodModel, level) -> tuple:
     """One crack-free mesh of the super-surfaces at ``level (S,)`` (-1: not drawn): ``(points (V, 3),
     triangles (T, 3), info)``; every edge between two drawn super-surfaces at levels ``k < l`` is drawn at
@@ -526,17 +541,8 @@ def assemble(lod: LodModel, level) -> tuple:
         if fans.size:
             need = edge_level[fans[:, 1]] < level[s]
             if need.any():
-                rows = fans[need]
-                keep = np.ones(tri.shape[0], dtype=bool)
-                extra = []
-                for t in np.unique(rows[:, 0]):
-                    pieces = [tuple(tri[t])]
-                    for _, eid, a, b, _c in rows[rows[:, 0] == t]:
-                        pieces = _split_side(pieces, a, b, _between(lod, eid, a, b, edge_level[eid]))
-                    keep[t] = False
-                    extra.append(np.array(pieces, dtype=np.int64))
-                    fanned += 1
-                tri = np.concatenate([tri[keep]] + extra)
+                tri, k = _fan_split(tri, fans[need], lambda eid, a, b: _between(lod, eid, a, b, edge_level[eid]))
+                fanned += k
         out.append(tri)
     tri = np.concatenate(out) if out else np.zeros((0, 3), dtype=np.int64)
     drawn = level[level >= 0]
