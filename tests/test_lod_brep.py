@@ -20,8 +20,9 @@ from _camera import background_from_inside
 LEVELS = 3
 
 
-def _plate(path):
-    """A plate with every edge filleted (cylinders, spheres with their poles at the corners) and six holes."""
+def _plate(path, offset=(0.0, 0.0)):
+    """A plate with every edge filleted (cylinders, spheres with their poles at the corners) and six holes, moved
+    by ``offset``."""
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
     from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
@@ -46,6 +47,13 @@ def _plate(path):
         for y in (1.0, 3.0):
             hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(x, y, -1), gp_Dir(0, 0, 1)), 0.4, 3.0).Shape()
             shape = BRepAlgoAPI_Cut(shape, hole).Shape()
+    if offset != (0.0, 0.0):
+        from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+        from OCP.gp import gp_Trsf, gp_Vec
+
+        move = gp_Trsf()
+        move.SetTranslation(gp_Vec(offset[0], offset[1], 0.0))
+        shape = BRepBuilderAPI_Transform(shape, move, True).Shape()
     writer = STEPControl_Writer()
     writer.Transfer(shape, STEPControl_AsIs)
     writer.Write(str(path))
@@ -159,3 +167,17 @@ def test_no_background_pixel_from_inside_the_filleted_plate(solids, focus):
         points, tri, _ = assemble(lod, level)
         # in the material, between the holes
         assert background_from_inside(points, tri, (2.0, 2.0, 0.5), focus, view_angle=70.0, far=20.0) == 0
+
+
+def test_a_corner_trim_off_its_side_is_taken_as_the_side(tmp_path):
+    """Moved to (16, 8), the plate as OpenCASCADE writes it has a corner sphere whose trim along its side runs off
+    that side by 0.0125 in the domain near the pole and 1.4e-3 in space (the fillet beside it has the side itself):
+    the trim is taken as the side, with a warning that says by how much, and the solid is closed."""
+    model = _plate(tmp_path / "moved.step", offset=(16.0, 8.0))
+    with pytest.warns(UserWarning, match="taken as the side"):
+        lod = build_lod(model, 0.005, levels=LEVELS, progress=False, workers=1)
+    for level in _combos(lod, count=3):
+        _, tri, _ = assemble(lod, level)
+        e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+        _, counts = np.unique(e, axis=0, return_counts=True)
+        assert counts.min() == 2 and counts.max() == 2

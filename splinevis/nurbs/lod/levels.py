@@ -371,7 +371,9 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         from .stitch import stitch_borders, update_chains
         from .trims import face_rings, merge_params, trim_plan
 
-        rings = face_rings(bs, model.trims, delta_trim, chord=0.5 * float(deltas[0] - delta_trim))
+        # a trim that touches its surface's side and stays within delta / 2 of it in space is that side
+        rings = face_rings(bs, model.trims, delta_trim, chord=0.5 * float(deltas[0] - delta_trim),
+                           side_near=0.5 * float(delta))
         stitch = stitch_borders(bs, edges, rings, chains, float(deltas[0]), tol)
         update_chains(stitch, chains, births, deltas.size)
         plan = trim_plan(bs, edges, stitch.rings, delta_trim)

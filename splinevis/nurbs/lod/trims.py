@@ -171,7 +171,7 @@ class TrimPlan(NamedTuple):
 _SIDE_LINES = (((0.0, 0.0), (1.0, 0.0)), ((1.0, 0.0), (1.0, 1.0)), ((0.0, 1.0), (1.0, 1.0)), ((0.0, 0.0), (0.0, 1.0)))
 
 
-def face_rings(bs, trims, delta_trim: float, chord=None) -> dict:
+def face_rings(bs, trims, delta_trim: float, chord=None, side_near=None) -> dict:
     """Per trimmed surface ``f`` of the model: ``(rings, h)``, its trim loops as closed polylines in its parameter
     domain (:func:`trim_polylines`) with the domain tolerance ``h = delta_trim / Lip``, ``Lip`` the largest
     :func:`gradient_bound` of its patches. The polylines hold every point where they cross a knot line, and with
@@ -197,10 +197,57 @@ def face_rings(bs, trims, delta_trim: float, chord=None) -> dict:
         # files give a loop along a surface's own border a hair inside it (OpenCASCADE: 1e-13 to 1e-10), and such
         # a loop is the border (drawn by the sides' chains, shared with the neighbour), not a trim
         dom = (bs.rect[ids, 0].min(), bs.rect[ids, 1].max(), bs.rect[ids, 2].min(), bs.rect[ids, 3].max())
+        near = 0.25 * float(delta_trim) if side_near is None else float(side_near)
+        loops = [[_side_curve(bs, int(f), c, dom, near, 0.25 * float(delta_trim)) for c in loop]
+                 for loop in trims[int(f)]]
         rings = [split_segments(bs, int(f), _snap_border(r, dom, 1e-3 * h), chord)
-                 for r in trim_polylines(trims[int(f)], 0.999 * h)]
+                 for r in trim_polylines(loops, 0.999 * h)]
         out[int(f)] = (rings, h)
     return out
+
+
+def _side_curve(bs, f, curve, dom, near, quiet=np.inf, samples: int = 65):
+    """``curve`` (a TrimCurve of surface ``f``), or the straight piece of a side of the domain ``dom`` it follows in
+    space: when the curve is off that side in the domain but at every one of ``samples`` points its surface point
+    lies within ``near`` of the surface point on the side with the same other parameter (a side that is not a
+    pole). OpenCASCADE gives the trim of a fillet's corner sphere along the sphere's side off it by up to 0.0125 in
+    u near the pole, 1.6e-5 to 1.4e-3 in space: that trim is the side, drawn by the sides' chains and shared with
+    the neighbour (checked at the samples, not proven); a gap above ``quiet`` is reported in a warning."""
+    from ..model import TrimCurve
+    from .bezier import evaluate, locate
+
+    def points(q):
+        p, st = locate(bs, f, q)
+        return evaluate(bs, p, st[:, 0], st[:, 1])
+
+    t = np.linspace(*curve.domain, samples)
+    uv = curve.evaluate(t)
+    X = points(uv)
+    size = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0)))
+    if size == 0.0:
+        return curve
+    span = max(dom[1] - dom[0], dom[3] - dom[2])
+    for axis, value in ((0, dom[0]), (0, dom[1]), (1, dom[2]), (1, dom[3])):
+        off = np.abs(uv[:, axis] - value)
+        if off.max() <= 1e-11 * span or off.min() > 1e-9 * span:
+            continue  # on the side already (to rounding), or not touching it: no trim of this kind
+        q = uv.copy()
+        q[:, axis] = value
+        Q = points(q)
+        if np.linalg.norm(Q.max(axis=0) - Q.min(axis=0)) <= 0.5 * size:
+            continue  # the side collapses here (a pole)
+        gap = float(np.linalg.norm(Q - X, axis=1).max())
+        if gap <= near:
+            if gap > quiet:
+                import warnings
+
+                warnings.warn(f"surface {f}: a trim curve that touches the side {'uv'[axis]} = {value:.6g} of its "
+                              f"domain runs {gap:.3g} off that side in space (more than the trims' share of the bound, "
+                              f"{quiet:.3g}): it is taken as the side, so the mesh there is within the level's bound "
+                              f"plus {gap:.3g} of the file's trim (the faces of the file disagree by as much).",
+                              UserWarning, stacklevel=2)
+            return TrimCurve(1, [0.0, 0.0, 1.0, 1.0], q[[0, -1]])
+    return curve
 
 
 def _snap_border(ring, dom, near):
