@@ -139,6 +139,23 @@ def _segment_distance(P, A, B):
     return np.linalg.norm(P[:, None, :] - Q, axis=-1), s
 
 
+def _onto_trim(bs, f, F, R, P, k, j, s, tol) -> list:
+    """Points ``P[k]`` near segments ``j`` (at ``s`` along them, in space) of the trim ring ``R`` of surface ``f``
+    (its record ``F``) put onto the surface by Gauss-Newton from the matching domain points: ``(k, segment,
+    domain point)`` of those that land within ``tol`` in space and within ``2 h`` of the ring in the domain
+    (segments along the domain's border left out)."""
+    if len(k) == 0:
+        return []
+    segs = np.asarray(R["uv"])
+    ok = R["free_seg"][j]
+    k, j, s = k[ok], j[ok], s[ok]
+    x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
+    x, gap = _invert_on_face(bs, f, x0, P[k], F["dom"])
+    off = _polyline_gap(x, segs, j)
+    keep = (gap <= tol) & (off <= 2.0 * F["h"] + 1e-12)
+    return [(int(kk), int(jj), tuple(xx)) for kk, jj, xx in zip(k[keep], j[keep], x[keep])]
+
+
 def _polyline_gap(x, ring, j):
     """Distances in the domain from points ``x (K, 2)`` to the closed polyline ``ring`` near segment ``j (K,)``
     (segments ``j - 1, j, j + 1``)."""
@@ -293,19 +310,9 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
                 S = G["rings"][si]
                 Q = np.asarray(S["X"])
                 k, j, s = near(P[free], Q, closed=True)
-                if k.size == 0:
-                    continue
-                k = free[k]
-                segs = np.asarray(S["uv"])
-                ok_seg = S["free_seg"][j]
-                k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
-                x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
-                x, gap = _invert_on_face(bs, g_, x0, P[k], G["dom"])
-                off = _polyline_gap(x, segs, j)
-                for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
-                    if gg <= tol and oo <= 2.0 * G["h"] + 1e-12:
-                        S["insert"].append((int(jj), tuple(xx), R["nodes"][kk], P[kk]))
-                        matched += 1
+                for kk, jj, xx in _onto_trim(bs, g_, G, S, P, free[k], j, s, tol):
+                    S["insert"].append((jj, xx, R["nodes"][kk], P[kk]))
+                    matched += 1
     # 2. open edges' chain points onto trims
     for e, E in ed.items():
         Pe = np.asarray(E["X"])
@@ -314,20 +321,11 @@ def stitch_borders(bs, edges, rings: dict, chains, delta: float, tol: float) -> 
                 continue
             F = faces[f]
             R = F["rings"][ri]
-            segs = np.asarray(R["uv"])
             k, j, s = near(Pe, R["X"], closed=True)
-            if k.size == 0:
-                continue
-            ok_seg = R["free_seg"][j]
-            k, j, s = k[ok_seg], j[ok_seg], s[ok_seg]
-            x0 = segs[j] + s[:, None] * (segs[(j + 1) % len(segs)] - segs[j])
-            x, gap = _invert_on_face(bs, f, x0, Pe[k], F["dom"])
-            off = _polyline_gap(x, segs, j)
-            for kk, jj, xx, gg, oo in zip(k, j, x, gap, off):
-                if gg <= tol and oo <= 2.0 * F["h"] + 1e-12:
-                    R["insert"].append((int(jj), tuple(xx), E["nodes"][kk], Pe[kk]))
-                    stitched.add(e)
-                    matched += 1
+            for kk, jj, xx in _onto_trim(bs, f, F, R, Pe, k, j, s, tol):
+                R["insert"].append((jj, xx, E["nodes"][kk], Pe[kk]))
+                stitched.add(e)
+                matched += 1
     # 3. apply: edges gain parameters (a point within tol of a chain point is that point), rings gain points
     edge_t = {}
     for e, E in ed.items():
