@@ -13,6 +13,7 @@ __all__ = [
     "OpenGLUnavailableError",
     "ShaderIncludeError",
     "ShaderCompileError",
+    "MeshTopologyError",
 ]
 
 
@@ -118,3 +119,19 @@ class ShaderCompileError(SplinevisError, RuntimeError):
         if not self.locations:
             parts.append("(the log names no source line; the full source is in .source)")
         super().__init__("\n".join(parts))
+
+
+class MeshTopologyError(SplinevisError, ValueError):
+    """A mesh is not what an algorithm needs (closed, manifold, connected, genus 0, outward); ``check`` names the
+    test that failed, the message says where and what to do.
+
+    Examples
+    --------
+    >>> e = MeshTopologyError("genus 0", "bunny has genus 1")
+    >>> e.check, str(e), isinstance(e, ValueError)
+    ('genus 0', 'genus 0: bunny has genus 1', True)
+    """
+
+    def __init__(self, check: str, message: str):
+        self.check = check
+        super().__init__(f"{check}: {message}")
