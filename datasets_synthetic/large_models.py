@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["teapot_field", "hull", "hull_spans"]
+__all__ = ["teapot_field", "hull", "hull_spans", "ellipse_loop", "rectangle_loop"]
 
 
 def teapot_field(n: int, spacing: float = 10.0, seed: int = 0):
@@ -104,8 +104,15 @@ def hull_spans(patches: int) -> tuple:
     return int(nu.ravel()[k]), int(nv.ravel()[k]), int(nd.ravel()[k])
 
 
-def _ellipse_loop(cu, cv, ru, rv):
-    """A closed trim loop: the exact rational ellipse about (cu, cv) with radii (ru, rv)."""
+def ellipse_loop(cu, cv, ru, rv):
+    """A closed trim loop: the exact rational ellipse about ``(cu, cv)`` with radii ``(ru, rv)`` (one quadratic
+    TrimCurve).
+
+    >>> c = ellipse_loop(0.5, 0.5, 0.2, 0.1)[0]
+    >>> p = c.evaluate([c.domain[0]])[0]
+    >>> bool(abs(((p[0] - 0.5) / 0.2) ** 2 + ((p[1] - 0.5) / 0.1) ** 2 - 1) < 1e-12)
+    True
+    """
     from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net
     from splinevis.nurbs.model import TrimCurve
 
@@ -113,7 +120,12 @@ def _ellipse_loop(cu, cv, ru, rv):
     return [TrimCurve(2, CIRCLE_KNOTS, np.array([cu, cv]) + np.array([ru, rv]) * xy, w)]
 
 
-def _border_loop(u0, u1, v0, v1):
+def rectangle_loop(u0, u1, v0, v1):
+    """A closed trim loop: the rectangle ``[u0, u1] x [v0, v1]`` counter-clockwise, four lines.
+
+    >>> [c.control_points.tolist() for c in rectangle_loop(0, 1, 0, 2)][:2]
+    [[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [1.0, 2.0]]]
+    """
     from splinevis.nurbs.model import TrimCurve
 
     c = [(u0, v0), (u1, v0), (u1, v1), (u0, v1), (u0, v0)]
@@ -182,7 +194,7 @@ def hull(patches: int = 20000, portholes: bool = True):
             if name == "portholes" and holes:
                 a, b = Vs[0], Vs[-1]
                 flip = side == "port"
-                loops = [_border_loop(0.0, 1.0, a, b)] + [_ellipse_loop(u, (a + b - t) if flip else t, ru, rv)
+                loops = [rectangle_loop(0.0, 1.0, a, b)] + [ellipse_loop(u, (a + b - t) if flip else t, ru, rv)
                                                             for u, t, ru, rv in holes]
             trims.append(loops)
     Sp, Ss = strakes[-1][1][:, -1], strakes[-1][1][:, -1] * mirror  # port and starboard sheer rows

@@ -383,21 +383,16 @@ def test_the_push_follows_the_camera_between_updates(lods):
 def test_a_close_up_keeps_the_trims():
     """The exact patches carry their surface's trim loops (in each patch's domain): a hole cut in the LOD mesh
     stays a hole drawn exactly, and patches trimmed away are not drawn."""
-    from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net
-    from splinevis.nurbs.model import TrimCurve
+    from datasets_synthetic.large_models import ellipse_loop, rectangle_loop
     from splinevis.nurbs.surface import NurbsSurface
 
     g = np.linspace(0.0, 1.0, 6)
     X, Y = np.meshgrid(g, g, indexing="ij")
     knots = [0, 0, 0, 0, 1 / 3, 2 / 3, 1, 1, 1, 1]
     s = NurbsSurface((3, 3), (knots, knots), np.stack([X, Y, 0.05 * np.sin(3 * X + 2 * Y)], axis=-1), None, "plate")
-    xy, w = circle_net()
-    border = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in
-              [((0, 0), (1, 0)), ((1, 0), (1, 1)), ((1, 1), (0, 1)), ((0, 1), (0, 0))]]
-    square = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in  # the centre patch, whole
-              [((1 / 3, 1 / 3), (2 / 3, 1 / 3)), ((2 / 3, 1 / 3), (2 / 3, 2 / 3)), ((2 / 3, 2 / 3), (1 / 3, 2 / 3)),
-               ((1 / 3, 2 / 3), (1 / 3, 1 / 3))]]
-    hole = [TrimCurve(2, CIRCLE_KNOTS, np.array([0.2, 0.25]) + 0.1 * xy, w)]  # across the knot line v = 1/3
+    border = rectangle_loop(0.0, 1.0, 0.0, 1.0)
+    square = rectangle_loop(1 / 3, 2 / 3, 1 / 3, 2 / 3)  # the centre patch, whole
+    hole = ellipse_loop(0.2, 0.25, 0.1, 0.1)  # across the knot line v = 1/3
     lod = build_lod(NurbsModel([s], trims=[[border, square, hole]]), 0.005, levels=2, progress=False)
     assert (lod.status == -1).sum() == 1
     pl = pv.Plotter(off_screen=True, window_size=(200, 200))

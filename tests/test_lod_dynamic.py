@@ -192,20 +192,17 @@ def test_no_background_pixel_from_inside_a_closed_model_with_refined_super_surfa
 def test_trimmed_model_refines_around_its_trims_without_cracks():
     """A torus with a hole across knot lines (tests/test_lod_trims.py): super-surfaces with a trimmed patch, and
     those across an edge holding trim crossings, stay static; the rest refine; the only border is the hole's."""
-    from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net
+    from datasets_synthetic.large_models import ellipse_loop, rectangle_loop
     from splinevis.nurbs.lod.levels import assemble
-    from splinevis.nurbs.model import NurbsModel, TrimCurve
+    from splinevis.nurbs.model import NurbsModel
     from splinevis.nurbs.operations import refine_knots
 
     s = torus()
     for d in (0, 1):
         k = np.unique(s.knots[d])
         s = refine_knots(s, d, 0.5 * (k[:-1] + k[1:]))
-    c = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
-    border = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in zip(c[:-1], c[1:])]
-    xy, w = circle_net()
-    hole = [TrimCurve(2, CIRCLE_KNOTS, np.array([0.37, 0.41]) + 0.17 * xy, w)]
-    lod = build_lod(NurbsModel([s], trims=[[border, hole]]), 0.02, levels=2, progress=False, workers=1)
+    loops = [rectangle_loop(0.0, 1.0, 0.0, 1.0), ellipse_loop(0.37, 0.41, 0.17, 0.17)]
+    lod = build_lod(NurbsModel([s], trims=[loops]), 0.02, levels=2, progress=False, workers=1)
     trimmed = {int(x) for x in lod.supers.labels[np.flatnonzero(lod.status != 0)]}
     assert trimmed
     r = Refiner(lod, ratio=RATIO, triangles_per_build=ALL)

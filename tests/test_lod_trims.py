@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from datasets_synthetic.large_models import hull
-from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net, torus
+from datasets_synthetic.large_models import ellipse_loop, hull, rectangle_loop
+from splinevis.nurbs.exact import torus
 from splinevis.nurbs.lod.levels import assemble, build_lod
 from splinevis.nurbs.lod.trims import gradient_bound, merge_params
-from splinevis.nurbs.model import NurbsModel, TrimCurve
+from splinevis.nurbs.model import NurbsModel
 from splinevis.nurbs.operations import refine_knots
 from splinevis.nurbs.surface import NurbsSurface
 from splinevis.nurbs.trim import inside, trim_pieces
@@ -22,27 +22,12 @@ from splinevis.nurbs.trim import inside, trim_pieces
 LEVELS = 3
 
 
-def _border():
-    c = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
-    return [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in zip(c[:-1], c[1:])]
-
-
-def _ellipse(cu, cv, ru, rv):
-    xy, w = circle_net()
-    return [TrimCurve(2, CIRCLE_KNOTS, np.array([cu, cv]) + np.array([ru, rv]) * xy, w)]
-
-
-def _square(u0, u1, v0, v1):
-    c = [(u0, v0), (u1, v0), (u1, v1), (u0, v1), (u0, v0)]
-    return [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in zip(c[:-1], c[1:])]
-
-
 def _torus_with_hole():
     s = torus()
     for d in (0, 1):
         k = np.unique(s.knots[d])
         s = refine_knots(s, d, 0.5 * (k[:-1] + k[1:]))
-    return NurbsModel([s], trims=[[_border(), _ellipse(0.37, 0.41, 0.17, 0.17)]])
+    return NurbsModel([s], trims=[[rectangle_loop(0.0, 1.0, 0.0, 1.0), ellipse_loop(0.37, 0.41, 0.17, 0.17)]])
 
 
 def _window():
@@ -54,8 +39,8 @@ def _window():
     s = NurbsSurface((3, 3), (knots, knots), P, None, "window")
     # an ellipse leaving the corners out; a circular hole across knot lines; a square hole that is one whole patch
     # (its sides on knot lines and on the border)
-    return NurbsModel([s], trims=[[_ellipse(0.5, 0.5, 0.49, 0.46), _ellipse(0.22, 0.3, 0.09, 0.1),
-                                   _square(1 / 3, 2 / 3, 1 / 3, 2 / 3)]])
+    return NurbsModel([s], trims=[[ellipse_loop(0.5, 0.5, 0.49, 0.46), ellipse_loop(0.22, 0.3, 0.09, 0.1),
+                                   rectangle_loop(1 / 3, 2 / 3, 1 / 3, 2 / 3)]])
 
 
 @pytest.fixture(scope="module")

@@ -338,7 +338,6 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None, conver
     >>> [s.name for s in surfaces][4:]
     ['face 4', 'lid']
     """
-    from OCP.BRep import BRep_Tool
     from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
@@ -352,9 +351,7 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None, conver
     for k, face in enumerate(faces):
         name = (names(face, k) if names is not None else None) or (
             prefix if (prefix and len(faces) == 1) else (f"{prefix} face {k}" if prefix else f"face {k}"))
-        surf = BRep_Tool.Surface_s(face)
-        if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
-            surf = surf.BasisSurface()
+        surf = _face_surface(face)
         kind_name = "no surface" if surf is None else surf.DynamicType().Name()
         if kind_name != "Geom_BSplineSurface" and surf is not None:
             face, surf = _nurbs_face(face)
@@ -373,9 +370,18 @@ def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None, conver
     return surfaces, trims
 
 
+def _face_surface(face):
+    """The face's surface (the basis of a rectangular trimmed one), or None."""
+    from OCP.BRep import BRep_Tool
+
+    surf = BRep_Tool.Surface_s(face)
+    if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
+        surf = surf.BasisSurface()
+    return surf
+
+
 def _nurbs_face(face):
     """The face converted to a B-spline face by OpenCASCADE and its surface, or ``(face, None)``."""
-    from OCP.BRep import BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
     from OCP.TopoDS import TopoDS
 
@@ -383,10 +389,7 @@ def _nurbs_face(face):
         new = TopoDS.Face(BRepBuilderAPI_NurbsConvert(face, True).Shape())
     except Exception:  # noqa: BLE001 -- OpenCASCADE refuses: the face is skipped and counted
         return face, None
-    surf = BRep_Tool.Surface_s(new)
-    if surf is not None and surf.DynamicType().Name() == "Geom_RectangularTrimmedSurface":
-        surf = surf.BasisSurface()
-    return new, surf
+    return new, _face_surface(new)
 
 
 def converted_note(converted: dict) -> str:

@@ -289,7 +289,9 @@ def write_markdown(out, result) -> Path:
                 ("triangles (mean)", "triangles_mean", "int"), ("visible super-surfaces", "visible_mean", "f1"),
                 ("mesh age mean / max", "age", "s"), ("select (ms)", "select_ms_mean", "f2"),
                 ("assemble max (ms)", "assemble_ms_max", "f1"), ("render (ms)", "render_ms_mean", "f1")]
-    for r in result["parts"] + result["vs_pixel_error"] + result["vs_delta"] + result["headline"] + e["flights"]:
+    cad = [result["cad"]] if result["cad"].get("available") else []
+    for r in (result["parts"] + result["vs_pixel_error"] + result["vs_delta"] + result["headline"] + e["flights"]
+              + result["finer"]["rows"] + cad):
         if "mesh_age_mean" in r:
             r["age"] = f"{r['mesh_age_mean']:.2f} / {r['mesh_age_max']}"
     t = result["threads"]
@@ -390,7 +392,6 @@ def _finer_markdown(result) -> list:
                                ("exact super-surfaces (max)", "closeup_max", "int")]), ""]
     if not c.get("available"):
         return md + ["## (g) A trimmed CAD assembly through STEP", "", c.get("note", "not run"), ""]
-    c["age"] = f"{c['mesh_age_mean']:.2f} / {c['mesh_age_max']}"
     return md + ["## (g) A trimmed CAD assembly through STEP", "",
                  f"{c['copies']} plate(s) with filleted edges and six holes each (planes, cylinders, corner spheres; "
                  f"{c['faces']:,} trimmed faces, {c['patches']:,} Bezier patches, {c['super_surfaces']:,} "

@@ -25,26 +25,23 @@ FINER_CONFIGS = [("static levels", dict(threaded=True)),
                  ("+ exact close-ups", dict(threaded=True, dynamic=True, closeup=True))]
 
 
-def _summary(frames) -> dict:
+def _finer_columns(frames) -> dict:
+    """What (f) adds to the fly-through's row: refined and waiting super-surfaces, exact close-ups."""
     mean = lambda k: float(np.mean([f.get(k, 0) for f in frames]))  # noqa: E731
-    t = np.array([f["time_ms"] for f in frames])
     exact = [f.get("closeup", 0) for f in frames]
-    return {"fps": 1e3 / float(t.mean()), "frame_mean_ms": float(t.mean()), "frame_max_ms": float(t.max()),
-            "triangles_mean": mean("triangles"), "needs_finer": mean("needs_finer"), "refined": mean("refined"),
-            "pending": mean("finer_pending"), "closeup_frames": int(sum(1 for x in exact if x)),
-            "age": f"{mean('mesh_age'):.2f} / {max((f.get('mesh_age', 0) for f in frames), default=0)}",
-            "closeup_max": int(max(exact) if exact else 0)}
+    return {"refined": mean("refined"), "pending": mean("finer_pending"),
+            "closeup_frames": int(sum(1 for x in exact if x)), "closeup_max": int(max(exact) if exact else 0)}
 
 
 def finer_than_level0(lod, path, fly, progress=False) -> list:
-    """(f): one row per configuration of :data:`FINER_CONFIGS` on ``path``; ``fly(lod, path, **options)`` returns
-    ``(row, frames)`` (the study's fly-through).
+    """(f): one row per configuration of :data:`FINER_CONFIGS` on ``path``: the row of ``fly(lod, path,
+    **options) -> (row, frames)`` (the study's fly-through) with the refined, waiting and exact super-surfaces.
 
     >>> from splinevis.nurbs.exact import sphere
     >>> from splinevis.nurbs.lod.levels import build_lod
     >>> from splinevis.nurbs.lod.pipeline import camera_path
-    >>> def fly(lod, path, **options):  # a stand-in: the frames of a still camera
-    ...     return {}, [{"time_ms": 10.0, "triangles": 8, "needs_finer": 1, "refined": 1, "closeup": 0}]
+    >>> def fly(lod, path, **options):  # a stand-in: the study's row and frames of a still camera
+    ...     return {"fps": 100.0}, [{"time_ms": 10.0, "triangles": 8, "needs_finer": 1, "refined": 1, "closeup": 0}]
     >>> rows = finer_than_level0(build_lod(sphere(), 0.05, levels=1, progress=False), [], fly)
     >>> [r["configuration"] for r in rows][-1], rows[0]["fps"]
     ('+ exact close-ups', 100.0)
@@ -56,8 +53,8 @@ def finer_than_level0(lod, path, fly, progress=False) -> list:
         options = dict(options)
         if options.pop("closeup", False):
             options["closeup"] = CloseUp(pixel_error=1.0)
-        _, frames = fly(lod, path, pixel_error=1.0, **options)
-        rows.append({"configuration": name, **_summary(frames)})
+        row, frames = fly(lod, path, pixel_error=1.0, **options)
+        rows.append({"configuration": name, **row, **_finer_columns(frames)})
     return rows
 
 
