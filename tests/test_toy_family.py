@@ -57,10 +57,10 @@ def test_toy_mesh_family_is_drawn_as_a_mesh_with_effects(toys):
     assert (pl.depth_buffer() < 1).sum() > 2000
     assert img[..., 0].std() > 20  # stripes, not a flat disc
     pl.close()
-    with pytest.raises(ValueError, match="cannot show the effects isophotes"):
+    with pytest.raises(ValueError, match="cannot show the effects colormap"):
         pl2 = splinevis.Plotter(off_screen=True, window_size=(40, 30))
         try:
-            pl2.add_spline(ToyMeshSphere(), isophotes=4)
+            pl2.add_spline(ToyMeshSphere(), colormap="viridis")
         finally:
             pl2.close()
 
