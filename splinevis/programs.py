@@ -8,7 +8,7 @@ Examples
 --------
 >>> from splinevis import programs
 >>> [p.name for p in programs.all_programs()]
-['analytic_patch', 'terrain', 'isosurface', 'nurbs_lod', 'nurbs']
+['analytic_patch', 'terrain', 'isosurface', 'nurbs_lod', 'nurbs', 'geometry_image']
 >>> programs.get("terrain").kind
 'raycast'
 """
@@ -25,7 +25,7 @@ __all__ = ["BUILTIN", "register", "unregister", "all_programs", "get", "program_
 BUILTIN = ("splinevis.analytic.program", "splinevis.terrain.program", "splinevis.volume.program",
            # two programs draw NURBS models: the level-of-detail meshes first, so that the per-fragment program,
            # registered later, is the one a NurbsModel finds by type (program_for); the other by name (get)
-           "splinevis.nurbs.lod.program", "splinevis.nurbs.program")
+           "splinevis.nurbs.lod.program", "splinevis.nurbs.program", "splinevis.geometry_image.program")
 
 _programs: dict[str, SplineProgram] = {}
 _loaded = False
@@ -88,7 +88,7 @@ def unregister(name: str) -> None:
     False
     >>> unregister("dots")
     Traceback (most recent call last):
-    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface, nurbs_lod, nurbs."
+    KeyError: "no program named 'dots'; registered: analytic_patch, terrain, isosurface, nurbs_lod, nurbs, geometry_image."
     """
     _load_builtin()
     if name not in _programs:
@@ -103,7 +103,7 @@ def all_programs() -> list[SplineProgram]:
     --------
     >>> [(p.name, p.kind) for p in all_programs()]
     [('analytic_patch', 'raycast'), ('terrain', 'raycast'), ('isosurface', 'raycast'), ('nurbs_lod', 'mesh'),
-     ('nurbs', 'surface')]
+     ('nurbs', 'surface'), ('geometry_image', 'passes')]
     """
     _load_builtin()
     return list(_programs.values())

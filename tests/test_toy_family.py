@@ -83,7 +83,8 @@ def test_registry_refuses_bad_programs_and_duplicates(toys):
 def test_after_unregistering_the_toy_is_unknown():
     with pytest.raises(TypeError, match="no spline program draws a ToySphere"):
         programs.program_for(ToySphere())
-    assert [p.name for p in programs.all_programs()] == ["analytic_patch", "terrain", "isosurface", "nurbs_lod", "nurbs"]
+    assert [p.name for p in programs.all_programs()] == ["analytic_patch", "terrain", "isosurface", "nurbs_lod", "nurbs",
+                                                          "geometry_image"]
 
 
 def test_every_builtin_program_follows_the_contract():

@@ -138,6 +138,12 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
 
     effects = style.effect_set()
     mesh, normals = _surface_with_normals(mesh)
+    # Model coordinates relative to the mesh's centre, the actor placed there: VTK's shift-scale of the vertex
+    # buffer is off (vertexMC must match the eye), so far from the origin (UTM-sized coordinates) float32 vertices
+    # would otherwise lose their digits; the eye goes into the same frame in double precision (camera_frame).
+    centre = np.asarray(mesh.center, dtype=np.float64) if mesh.n_points else np.zeros(3)
+    mesh = mesh.copy(deep=False)
+    mesh.points = np.asarray(mesh.points, dtype=np.float64) - centre
     mapper = vtkOpenGLPolyDataMapper()
     mapper.SetInputData(mesh)
     mapper.ScalarVisibilityOff()
@@ -149,6 +155,7 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
         mapper.MapDataArrayToVertexAttribute("svMeshCurvature", CURVATURE_ARRAY, 0, -1)
     actor = vtkActor()
     actor.SetMapper(mapper)
+    actor.SetPosition(*centre)
     prop = actor.GetProperty()
     prop.SetColor(*style.color)
     prop.SetInterpolationToPhong()
@@ -163,7 +170,7 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
         add = sp.AddVertexShaderReplacement if stage == "vertex" else sp.AddFragmentShaderReplacement
         add(tag, True, text, False)
     renderer = plotter.renderer
-    frame = SimpleNamespace(renderer=renderer, offset=np.zeros(3), position=np.zeros(3), rotation=None)
+    frame = SimpleNamespace(renderer=renderer, offset=centre, position=centre, rotation=None)
     style_uniforms = style.uniforms()
     actor.program_sources = {}
 
@@ -173,7 +180,7 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
         if not actor.program_sources:
             actor.program_sources = {"vertex": program.GetVertexShader().GetSource(),
                                      "fragment": program.GetFragmentShader().GetSource()}
-        # the mesh is in world coordinates: the model frame of a spline actor without offset or rotation
+        # the model frame: world shifted by the mesh's centre, as a spline actor with that offset and no rotation
         eye, view, parallel, world_from_cam = SplineActor.camera_frame(frame)
         uniforms = {"sv_eye_mc": eye, "sv_view_dir_mc": view, "sv_parallel": int(parallel)}
         if "isophotes" in effects:
