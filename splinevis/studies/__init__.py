@@ -11,7 +11,7 @@ scheme is not available), is listed by :func:`notes`.
 Examples
 --------
 >>> sorted(STUDIES)
-['nurbs', 'terrain', 'volume', 'walkthrough']
+['geometry-image', 'nurbs', 'terrain', 'volume', 'walkthrough']
 >>> STUDIES["volume"].runner
 'splinevis.studies.volume:run_volume_study'
 """
@@ -84,6 +84,8 @@ STUDIES = {s.name: s for s in (
           "NURBS zebra stripes per fragment against tessellated meshes (ours and OpenCASCADE's)"),
     Study("walkthrough", "splinevis.studies.walkthrough:run_walkthrough_study",
           "large NURBS models at interactive rates: levels of detail, culling, threads [Kumar1997]"),
+    Study("geometry-image", "splinevis.studies.geometry_image:run_geometry_image_study",
+          "smooth geometry images: GPU subdivision passes against the twin and against Loop/Catmull-Clark [Losasso2003]"),
 )}
 
 
@@ -102,7 +104,7 @@ def get(name: str) -> Study:
     >>> get("sphere")
     Traceback (most recent call last):
     ...
-    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough'.
+    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough', 'geometry-image'.
     """
     try:
         return STUDIES[name]
