@@ -41,6 +41,10 @@ WITHOUT_EXAMPLES = {
     # 6-8 offscreen scenes with VolumeSpline builds: 1.2 s even at n=8 in a 40x30 window, and a close-up
     # that tiny is all surface (nothing meaningful to show)
     "splinevis.studies.volume_figures": {"side_by_side_figure"},
+    # the geometry-image study (8 s with quick=True) and its pipeline figure (a spherical parametrization, a
+    # fit and six panels, three of them offscreen scenes of 360x300)
+    "splinevis.studies.geometry_image": {"run_geometry_image_study"},
+    "splinevis.studies.geometry_image_figures": {"pipeline_figure"},
 }
 
 

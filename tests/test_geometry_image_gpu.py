@@ -20,22 +20,36 @@ Derivation (unit roundoff u = 2^-24 for float32, 2^-53 for the twin's float64; g
   component: gamma_2 |a||b| each, sqrt(3) gamma_2 |a||b| as a vector). The angle of v moves by at most
   arcsin(|dv| / |v|); normalizing (one rounded multiplication per component) adds u. |T| and |v| are taken
   from the twin (its own error bound added/subtracted).
-* Cut vertices: P_ss, P_tt (9 terms, sum|w| = 4, c = 10), P_st (4 terms, sum|w| = 1, c = 3), and
-  w = P_ss x P_st + P_st x P_tt: the same perturbation of the two cross products, their rounding gamma_3.
-  At deep levels these second differences are a few ulps of the coordinates (the float32 resolution of
-  g^k, not an error of the passes): the bound grows as 4^k and saturates at pi / 2, and the test reports it.
+* Cut vertices: the normal is the float64 cut_normals of the level-0 image (the twin uses the same), rounded
+  to float32 as a uniform: each component within u of its value, so the angle is <= arcsin(u).
+* Curvature (gi_curvature.glsl and the twin's curvature), per texel, propagating absolute error bounds
+  through every operation with the twin's magnitudes (|exact x| <= |twin x| + the twin's own bound):
+  derivatives as above (|dT| <= sqrt(3) e_T, P_ss and P_tt: 9 terms with sum|w| = 4, c = 10; P_st: 4 terms,
+  sum|w| = 1, c = 3); v = T_s x T_t as for the normals; a dot product of 3-vectors changes by
+  |a| db + da |b| + da db and rounds by gamma_3 |a'| |b'|; D = v . v; n = v inversesqrt(D): |dn| <= 2 |dv| / |v|
+  plus gamma_{4 + r} (the rounding of D, r u for the reciprocal square root, one product); a product by
+  |x| dy + dx |y| + dx dy; the numerators E N - 2 F M + G L and L N - M^2 by the sum of their terms' errors
+  plus gamma_3 (gamma_2) of the sum of their magnitudes (any order, FMA or not); a quotient A / D by
+  (dA + |A / D| dD) / (D - dD) plus the division's rounding q u |quotient|. r and q: GLSL 4.50 allows
+  inversesqrt 2 ulp and x / y 2.5 ulp (an ulp <= 2 u relative): r = 4, q = 5 for float32; float64 numpy
+  rounds correctly: r = 2 (sqrt, then a division), q = 1. Where dD >= D the derivation bounds nothing (the
+  float32 second differences no longer resolve the curvature): the bound is infinite and the test reports
+  how many texels that is. The cut vertices hold the mean of four neighbours: their bounds / 4 plus gamma_2
+  of the magnitudes / 4.
 * Measuring the angle between the two normals in float64 (atan2 of |a x b| and a . b) adds <= 8 u_64.
 
 Nothing is tuned: the bounds are these formulas with the level's magnitudes.
+Curvature's sign convention is the NURBS programs' (H = -1/r on a sphere with outward normals).
 """
 
 import numpy as np
 import pytest
 
-from splinevis.geometry_image.gpu import displace_gpu, geomorph_gpu, subdivide_gpu
-from splinevis.geometry_image.image import apply_cut_constraint, cut_vertices, image_uv, octahedral_to_sphere, pad, symmetrize
-from splinevis.geometry_image.subdivision import (average, displace, geomorph, limit, normals, second_derivatives, split,
-                                                  subsample, tangents)
+from splinevis.geometry_image.gpu import curvature_gpu, displace_gpu, geomorph_gpu, subdivide_gpu
+from splinevis.geometry_image.image import (apply_cut_constraint, cut_neighbours, cut_vertices, image_uv,
+                                            octahedral_to_sphere, pad, symmetrize)
+from splinevis.geometry_image.subdivision import (average, curvature, cut_normals, displace, geomorph, limit, normals,
+                                                  second_derivatives, split, subsample, tangents)
 
 pytestmark = pytest.mark.gl
 
@@ -67,23 +81,13 @@ def _norm(x):
 
 
 def normal_angle_bound(g, e_g, M, u):
-    """Per texel bound on the angle between the computed and the exact normal (see the module docstring),
+    """Per texel bound on |computed v - exact v| for v = T_s x T_t (see the module docstring) and |twin v|,
     ``g`` the twin's padded control image, ``e_g`` the componentwise bound on the computation's g^k."""
     e_t = e_g + gamma(C_TANGENT, u) * (M + e_g)
     ts, tt = tangents(g)
     dT = np.sqrt(3.0) * e_t
     dv = cross_error(_norm(ts), dT, _norm(tt), dT, u)
-    v = np.cross(ts, tt)
-    cut = cut_vertices(v.shape[0])
-    e_ss = 4.0 * e_g + gamma(C_PSS, u) * 4.0 * (M + e_g)
-    e_st = e_g + gamma(C_PST, u) * (M + e_g)
-    for r, c in cut:
-        pss, pst, ptt = (np.linalg.norm(d[0, 0]) for d in second_derivatives(g[r:r + 3, c:c + 3]))
-        dss, dst = np.sqrt(3.0) * e_ss, np.sqrt(3.0) * e_st
-        dv[r, c] = cross_error(pss, dss, pst, dst, u, 3) + cross_error(pst, dst, ptt, dss, u, 3)
-        d2 = second_derivatives(g[r:r + 3, c:c + 3])
-        v[r, c] = np.cross(d2[0][0, 0], d2[1][0, 0]) + np.cross(d2[1][0, 0], d2[2][0, 0])
-    return dv, _norm(v)
+    return dv, _norm(np.cross(ts, tt))
 
 
 def angle_bound(g, e32, e64, M):
@@ -91,7 +95,98 @@ def angle_bound(g, e32, e64, M):
     dv64, _ = normal_angle_bound(g, e64, M, U64)
     floor = vn - dv64  # |exact v| >= |twin v| - its error
     ratio = np.where(floor > 0, (dv32 + dv64) / np.where(floor > 0, floor, 1.0), 1.0)
-    return np.arcsin(np.minimum(ratio, 1.0)) + U32 + U64 + 8 * U64
+    bound = np.arcsin(np.minimum(ratio, 1.0)) + U32 + U64 + 8 * U64
+    # cut vertices: the twin's float64 normal rounded to float32 (the uniform), measured in float64
+    cv = cut_vertices(bound.shape[0])
+    bound[cv[:, 0], cv[:, 1]] = np.arcsin(U32) + 8 * U64
+    return bound
+
+
+def _dot_error(a, da, b, db, u):
+    """|computed a' . b' - a . b| for 3-vectors of norms a, b (exact) and errors da, db."""
+    return a * db + da * b + da * db + gamma(3, u) * (a + da) * (b + db)
+
+
+def _product_error(x, dx, y, dy):
+    return x * dy + dx * y + dx * dy
+
+
+def _quotient_error(A, dA, D, dD, u, q):
+    """|A' / D' - A / D| with the division's rounding (q u relative); infinite where dD >= D."""
+    ok = dD < D
+    Dl = np.where(ok, D - dD, 1.0)
+    d = (dA + A / np.where(D > 0, D, 1.0) * dD) / Dl
+    d = d + q * u * (A / np.where(D > 0, D, 1.0) + d)
+    return np.where(ok, d, np.inf)
+
+
+def _twin_forms(g):
+    """The twin's intermediate values of the curvature formula (absolute values and norms), per texel."""
+    ts, tt = tangents(g)
+    pss, pst, ptt = second_derivatives(g)
+    v = np.cross(ts, tt)
+    D = (v * v).sum(-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = v / np.sqrt(D)[..., None]
+    E, F, G = (ts * ts).sum(-1), (ts * tt).sum(-1), (tt * tt).sum(-1)
+    L, M, N = ((x * n).sum(-1) for x in (pss, pst, ptt))
+    x = {"ts": _norm(ts), "tt": _norm(tt), "pss": _norm(pss), "pst": _norm(pst), "ptt": _norm(ptt), "v": _norm(v),
+         "D": D, "E": E, "F": F, "G": G, "L": L, "M": M, "N": N, "EN": E * N, "2FM": 2 * F * M, "GL": G * L,
+         "LN": L * N, "MM": M * M}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x["A"] = x["EN"] - x["2FM"] + x["GL"]
+        x["B"] = x["LN"] - x["MM"]
+    return {k: np.nan_to_num(np.abs(a), nan=0.0, posinf=0.0) for k, a in x.items()}
+
+
+def curvature_errors(x, e_g, M, u, r, q):
+    """Per texel bounds on |computed H - exact H| and |computed K - exact K| (module docstring), ``x`` the
+    magnitudes of the exact intermediate values, ``e_g`` the componentwise bound on the computation's g^k;
+    with every intermediate error (dict)."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # NaN at the cut vertices: replaced there
+        return _curvature_errors(x, e_g, M, u, r, q)
+
+
+def _curvature_errors(x, e_g, M, u, r, q):
+    d = {}
+    d["ts"] = d["tt"] = np.sqrt(3.0) * (e_g + gamma(C_TANGENT, u) * (M + e_g))
+    d["pss"] = d["ptt"] = np.sqrt(3.0) * (4.0 * e_g + gamma(C_PSS, u) * 4.0 * (M + e_g))
+    d["pst"] = np.sqrt(3.0) * (e_g + gamma(C_PST, u) * (M + e_g))
+    d["v"] = cross_error(x["ts"], d["ts"], x["tt"], d["tt"], u)
+    d["D"] = _dot_error(x["v"], d["v"], x["v"], d["v"], u)
+    dn = np.where(d["v"] < x["v"], 2.0 * d["v"] / x["v"], np.inf) + gamma(4 + r, u)
+    for a, p in (("L", "pss"), ("M", "pst"), ("N", "ptt")):
+        d[a] = _dot_error(x[p], d[p], 1.0, dn, u)
+    for a, (b, c) in (("E", ("ts", "ts")), ("F", ("ts", "tt")), ("G", ("tt", "tt"))):
+        d[a] = _dot_error(x[b], d[b], x[c], d[c], u)
+    d["EN"] = _product_error(x["E"], d["E"], x["N"], d["N"])
+    d["2FM"] = 2.0 * _product_error(x["F"], d["F"], x["M"], d["M"])
+    d["GL"] = _product_error(x["G"], d["G"], x["L"], d["L"])
+    d["LN"] = _product_error(x["L"], d["L"], x["N"], d["N"])
+    d["MM"] = _product_error(x["M"], d["M"], x["M"], d["M"])
+    terms_A, terms_B = ("EN", "2FM", "GL"), ("LN", "MM")
+    d["A"] = sum(d[t] for t in terms_A) + gamma(3, u) * sum(x[t] + d[t] for t in terms_A)
+    d["B"] = sum(d[t] for t in terms_B) + gamma(2, u) * sum(x[t] + d[t] for t in terms_B)
+    dH = 0.5 * _quotient_error(x["A"], d["A"], x["D"], d["D"], u, q)
+    dK = _quotient_error(x["B"], d["B"], x["D"], d["D"], u, q)
+    return dH, dK, d
+
+
+def curvature_bound(g, e32, e64, M, H, K):
+    """Bounds on |GPU H - twin H| and |GPU K - twin K| per texel: the GPU's and the twin's bounds added."""
+    x = _twin_forms(g)
+    _, _, d64 = curvature_errors(x, e64, M, U64, 2, 1)
+    x = {k: a + d64.get(k, 0.0) for k, a in x.items()}  # |exact| <= |twin| + the twin's error
+    out = []
+    for value, (b32, b64) in zip((H, K), zip(curvature_errors(x, e32, M, U32, 4, 5)[:2],
+                                              curvature_errors(x, e64, M, U64, 2, 1)[:2])):
+        b = b32 + b64
+        m = b.shape[0]
+        for (r, c), nb in zip(cut_vertices(m), cut_neighbours(m)):  # mean of 4: error / 4 + gamma_2 sum / 4
+            bn, vn = b[nb[:, 0], nb[:, 1]], np.abs(value[nb[:, 0], nb[:, 1]])
+            b[r, c] = 0.25 * bn.sum() + (gamma(2, U32) + gamma(2, U64)) * 0.25 * (vn + bn).sum()
+        out.append(b)
+    return out
 
 
 def _angle(a, b):
@@ -136,6 +231,8 @@ def test_gpu_subdivision_equals_the_twin_within_derived_bounds(name):
         bound = angle_bound(g, e32[k], e64[k], M)
         assert (ang <= bound).all(), (k, float((ang - bound).max()))
         cv = cut_vertices(gpu.p.shape[0])
+        # at the cut vertices: the level-0 float64 normal rounded to float32, the same bits at every level
+        assert np.array_equal(gpu.n[cv[:, 0], cv[:, 1]], cut_normals(pad(G)).astype(np.float32))
         regular = np.ones(ang.shape, bool)
         regular[cv[:, 0], cv[:, 1]] = False
         rows.append((k, dg / U32, ep / U32, dp / U32, float(ang[regular].max()), float(np.median(bound[regular])),
@@ -144,6 +241,43 @@ def test_gpu_subdivision_equals_the_twin_within_derived_bounds(name):
           "max angle/bound; at cut vertices: max angle, max bound")
     for r in rows:
         print("  %d  %5.2f  %6.2f  %5.2f   %.2e  %.2e  %.3f   %.2e  %.2e" % r)
+
+
+CURVATURE_LEVELS = 4
+
+
+@pytest.mark.parametrize("name", sorted(IMAGES))
+def test_gpu_curvature_equals_the_twin_within_derived_bounds(name):
+    G = IMAGES[name]
+    M = float(np.abs(G).max())
+    e32 = control_bounds(CURVATURE_LEVELS, M, U32, upload=1)
+    e64 = control_bounds(CURVATURE_LEVELS, M, U64, upload=0)
+    g = pad(G)
+    rows = []
+    for k in range(CURVATURE_LEVELS + 1):
+        if k:
+            g = average(split(g))
+        H, K = curvature(g)
+        sub = subdivide_gpu(G, k, curvature=True)
+        Hg, Kg = curvature_gpu(sub.g)
+        assert np.array_equal(sub.curvature, np.stack([Hg, Kg], axis=-1))  # in the chain or on its own
+        bH, bK = curvature_bound(g, e32[k], e64[k], M, H, K)
+        cv = cut_vertices(H.shape[0])
+        cut = np.zeros(H.shape, bool)
+        cut[cv[:, 0], cv[:, 1]] = True
+        row = [k]
+        for got, want, bound in ((Hg, H, bH), (Kg, K, bK)):
+            err = np.abs(got.astype(np.float64) - want)
+            assert np.isfinite(got).all()
+            assert (err <= bound).all(), (k, float(np.nanmax(err - bound)))
+            finite = np.isfinite(bound)
+            row += [float(np.median(np.abs(want))), float(err.max()), float(np.median(err)), float(np.median(bound)),
+                    float((err / bound)[finite].max()), float((err / bound)[cut].max()), 1.0 - finite.mean()]
+        rows.append(tuple(row))
+    print(f"\n{name}: level; for H then K: median|value|, max|error|, median|error|, median bound, "
+          "max error/bound, max error/bound at the cut vertices, share of texels without a finite bound")
+    for r in rows:
+        print("  %d   %.2f %.1e %.1e %.1e %.3f %.4f %.0e    %.2f %.1e %.1e %.1e %.3f %.4f %.0e" % r)
 
 
 def test_geomorph_and_displace_passes_equal_the_twin():

@@ -2,17 +2,21 @@
 the paper's exact properties: L is the floor formula, one step A[L[g]] is knot insertion of the bicubic
 B-spline on the padded image, the padding stays the X-cut padding bit for bit, E and the tangent masks are
 the B-spline and its derivatives at the samples, subsampling the next level gives this level, geomorph's
-ends are exact, and the normal at a cut vertex (unit(P_ss x P_st + P_st x P_tt)) is the limit of the normals
-around it."""
+ends are exact, the normal at a cut vertex (unit(P_ss x P_st + P_st x P_tt)) is the limit of the normals
+around it and the same at every level, and the curvatures are those of the float64 surface
+(splinevis.geometry_image.model.GeometryImage) with the NURBS programs' sign convention."""
 
 import numpy as np
 import pytest
 from scipy.interpolate import NdBSpline
 
-from splinevis.geometry_image.image import (apply_cut_constraint, cut_vertices, image_uv, octahedral_to_sphere, pad,
-                                            symmetrize)
-from splinevis.geometry_image.subdivision import (average, displace, geomorph, grid_faces, limit, linear_subdivide,
-                                                  normals, second_derivatives, split, subdivide, subsample, tangents)
+from splinevis.geometry_image.image import (apply_cut_constraint, cut_neighbours, cut_vertices, image_uv,
+                                            octahedral_to_sphere, pad, symmetrize)
+from splinevis.geometry_image.model import GeometryImage
+from splinevis.geometry_image.subdivision import (average, curvature, cut_normals, displace, geomorph, grid_faces, limit,
+                                                  linear_subdivide, normals, second_derivatives, split, subdivide,
+                                                  subsample, tangents)
+from splinevis.nurbs.surface import fundamental_curvature
 
 
 def _sphere(n):
@@ -200,6 +204,128 @@ def test_tangents_vanish_at_cut_vertices_and_the_cut_normal_is_the_limit_of_its_
     # distance (C^1 at the cut vertex, with a well-defined normal there)
     assert (worst[3:] < 0.6 * worst[2:-1] + 1e-12).all(), worst
     assert worst[-1] < 0.04, worst
+
+
+U64 = 2.0 ** -53
+
+
+def _gamma(c):
+    return c * U64 / (1.0 - c * U64)
+
+
+def _cut_normal_angle_bound(g, e_g, M):
+    """Bound on the angle between the computed and the exact unit(P_ss x P_st + P_st x P_tt) at each cut vertex
+    of the padded image g (float64, componentwise error bound e_g on g): P_ss, P_tt are 9-term sums with
+    sum|w| = 4 (8 roundings, 2 more for the constant 1/6), P_st 4 terms with sum|w| = 1 (3 roundings); a cross
+    product of a, b (norms) with errors da, db changes by a db + da b + da db and rounds by sqrt(3) gamma_2
+    (a + da)(b + db), the sum of the two by gamma_3 in all; the angle of w moves by arcsin(|dw| / (|w| - |dw|)),
+    normalizing adds 2 u."""
+    dss = np.sqrt(3.0) * (4.0 * e_g + _gamma(10) * 4.0 * (M + e_g))
+    dst = np.sqrt(3.0) * (e_g + _gamma(3) * (M + e_g))
+    out = []
+    for r, c in cut_vertices(g.shape[0] - 2):
+        pss, pst, ptt = (np.linalg.norm(d[0, 0]) for d in second_derivatives(g[r:r + 3, c:c + 3]))
+        dw = sum(a * db + da * b + da * db + np.sqrt(3.0) * _gamma(3) * (a + da) * (b + db)
+                 for a, da, b, db in ((pss, dss, pst, dst), (pst, dst, ptt, dss)))
+        w = np.linalg.norm(_cut_w(g, r, c))
+        out.append(np.arcsin(min(1.0, dw / (w - dw))) + 2 * U64)
+    return np.array(out)
+
+
+def _cut_w(g, r, c):
+    pss, pst, ptt = (d[0, 0] for d in second_derivatives(g[r:r + 3, c:c + 3]))
+    return np.cross(pss, pst) + np.cross(pst, ptt)
+
+
+@pytest.mark.parametrize("G", [_sphere(17), _bumpy(17, seed=12), _bumpy(17, seed=13, amount=0.1)],
+                         ids=["sphere", "bumpy", "bumpier"])
+def test_the_cut_vertex_normal_is_the_same_at_every_level(G):
+    """The level-k formula in float64 equals the level-0 value within the derived rounding bound (the second
+    differences of g^k are 4^-k of level 0's, so the bound grows as 4^k: 1e-13 at level 0, 8e-10 at level 5), and
+    subdivide uses the level-0 value at every level."""
+    M = float(np.abs(G).max())
+    g = pad(G)
+    level0 = cut_normals(g)
+    e_g, rows = 0.0, []
+    bound0 = _cut_normal_angle_bound(g, 0.0, M)
+    for k in range(6):
+        if k:
+            g = average(split(g))
+            x = e_g + _gamma(3) * (M + e_g)  # split, then average (tests/test_geometry_image_gpu.py)
+            e_g = x + _gamma(15) * (M + x)
+        cv = cut_vertices(g.shape[0] - 2)
+        at_k = cut_normals(g)
+        assert np.array_equal(normals(g)[cv[:, 0], cv[:, 1]], at_k)
+        assert np.array_equal(subdivide(G, k).n[cv[:, 0], cv[:, 1]], level0)
+        angle = _angle(at_k, level0)
+        bound = _cut_normal_angle_bound(g, e_g, M) + bound0 + 8 * U64
+        assert (angle <= bound).all(), (k, angle, bound)
+        rows.append((k, angle.max(), bound.max()))
+    assert rows[-1][2] < 1e-9, rows  # measured <= 7e-13
+
+
+def _reference_curvature(G, level):
+    """H, K (and the larger |principal curvature|) of the float64 surface at the samples of a level, from its
+    derivatives, by the NURBS model's formula."""
+    gi = GeometryImage(G)
+    st = gi.sample_grid(level)
+    m = st.shape[0]
+    SKL = np.zeros((m * m, 3, 3, 3))
+    for (i, j), d in zip([(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)], gi.evaluate(st, derivatives=2)):
+        SKL[:, i, j] = d.reshape(-1, 3)  # (u, v) = (s, t): the normal is unit(P_s x P_t), as the twin's
+    c = fundamental_curvature(SKL)
+    kappa = np.maximum(np.abs(c["k1"]), np.abs(c["k2"]))
+    return c["H"].reshape(m, m), c["K"].reshape(m, m), kappa.reshape(m, m)
+
+
+@pytest.mark.parametrize("G", [_sphere(17), _bumpy(17, seed=15), _bumpy(17, seed=16, amount=0.1)],
+                         ids=["sphere", "bumpy", "bumpier"])
+@pytest.mark.parametrize("level", [0, 1, 2, 3])
+def test_curvature_is_the_float64_surfaces(G, level):
+    """Relative to the larger principal curvature |k| (K to k^2): ~1e-14 at level 0; both float64 sides lose
+    digits near the cut vertices, where the tangents shrink (measured 1e-11 at level 3)."""
+    H, K = curvature(subdivide(G, level).g)
+    Hr, Kr, kappa = _reference_curvature(G, level)
+    cv = cut_vertices(H.shape[0])
+    regular = np.ones(H.shape, bool)
+    regular[cv[:, 0], cv[:, 1]] = False
+    assert not np.isnan(Hr[regular]).any()
+    assert (np.abs(H - Hr)[regular] <= 1e-10 * kappa[regular]).all()
+    assert (np.abs(K - Kr)[regular] <= 1e-10 * kappa[regular] ** 2).all()
+    # at the cut vertices the first fundamental form is singular (the reference divides rounding noise there);
+    # the twin returns the mean of the four closed-mesh neighbours, a stand-in, not the surface's curvature
+    for (r, c), nb in zip(cv, cut_neighbours(H.shape[0])):
+        for a in (H, K):
+            v = a[nb[:, 0], nb[:, 1]]
+            assert a[r, c] == ((v[0] + v[1]) + (v[2] + v[3])) / 4.0
+
+
+@pytest.mark.parametrize("level", [0, 2, 4])
+def test_sphere_curvature_signs_are_the_nurbs_programs(level):
+    """Outward normals on a convex surface: K > 0 and both principal curvatures negative (H < 0), as the NURBS
+    model's unit sphere has H = -1, K = 1 (tests/test_nurbs_model.py); near 1 in size where the octahedral
+    image is smooth."""
+    H, K = curvature(subdivide(_sphere(33), level).g)
+    assert np.isfinite(H).all() and np.isfinite(K).all()
+    assert (K > 0).all() and (H < 0).all() and (H * H >= K * (1 - 1e-12)).all()
+    assert 0.8 < -np.median(H) < 1.25 and 0.8 < np.median(K) < 1.6
+    # parametrization-invariant: the same curvature at the same surface point on every level
+    H0, K0 = curvature(subdivide(_sphere(33), 0).g)
+    s = 1 << level
+    cv = cut_vertices(H0.shape[0])
+    regular = np.ones(H0.shape, bool)
+    regular[cv[:, 0], cv[:, 1]] = False
+    assert np.allclose(H[::s, ::s][regular], H0[regular], rtol=1e-10, atol=0)
+    assert np.allclose(K[::s, ::s][regular], K0[regular], rtol=1e-10, atol=0)
+
+
+def test_curvature_needs_xyz_and_an_odd_image():
+    with pytest.raises(ValueError):
+        curvature(np.zeros((7, 7)))
+    with pytest.raises(ValueError):
+        curvature(np.zeros((6, 6, 3)))
+    with pytest.raises(ValueError):
+        normals(pad(_sphere(9)), at_cut=np.zeros((3, 3)))
 
 
 def test_without_the_centroid_constraint_the_second_derivatives_are_not_coplanar():

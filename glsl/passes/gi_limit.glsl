@@ -3,12 +3,16 @@
 //   sv_frag_out0: E[g] = [1 4 1]^T [1 4 1] / 36 (all four channels)
 //   sv_frag_out1: unit(T_s x T_t) in xyz (w = 0), T_s = d/ds along a row (x), T_t = d/dt across rows (y);
 //                 at the four cut vertices (the border midpoints of the interior, eq. 1) the tangents
-//                 vanish and the normal is unit(P_ss x P_st + P_st x P_tt) (C^1 with the centroid
-//                 constraint, eq. 2 and appendix). A zero vector gives a zero normal.
+//                 vanish and the normal is sv_cut_normal[i], in the order of
+//                 splinevis.geometry_image.image.cut_vertices (top row, bottom row, left column, right
+//                 column): unit(P_ss x P_st + P_st x P_tt) computed once in float64 from the level-0 image
+//                 (the same point and normal at every level; in float32 its second differences would lose
+//                 4^k of the precision at level k). A zero vector gives a zero normal.
 // Rounding: the limit mask sums 9 terms with exact integer weights (<= 8 roundings in any order), then one
 // multiplication by the rounded constant 1/36 (2 more). CPU twin: splinevis.geometry_image.subdivision
-// (limit, tangents, second_derivatives, normals).
+// (limit, tangents, cut_normals, normals).
 uniform sampler2D sv_src;
+uniform vec3 sv_cut_normal[4];
 
 void main() {
     ivec2 q = ivec2(gl_FragCoord.xy);
@@ -26,26 +30,16 @@ void main() {
 
     int N = textureSize(sv_src, 0).x - 3;  // the interior has N + 1 samples per side
     int h = N / 2;
-    bool cut = (q.x == h && (q.y == 0 || q.y == N)) || (q.y == h && (q.x == 0 || q.x == N));
-    vec3 v;
-    if (cut) {
-        vec3 es0 = (g[0].xyz + g[2].xyz) - 2.0 * g[1].xyz;
-        vec3 es1 = (g[3].xyz + g[5].xyz) - 2.0 * g[4].xyz;
-        vec3 es2 = (g[6].xyz + g[8].xyz) - 2.0 * g[7].xyz;
-        vec3 pss = ((es0 + es2) + 4.0 * es1) * (1.0 / 6.0);
-        vec3 et0 = (g[0].xyz + g[6].xyz) - 2.0 * g[3].xyz;
-        vec3 et1 = (g[1].xyz + g[7].xyz) - 2.0 * g[4].xyz;
-        vec3 et2 = (g[2].xyz + g[8].xyz) - 2.0 * g[5].xyz;
-        vec3 ptt = ((et0 + et2) + 4.0 * et1) * (1.0 / 6.0);
-        vec3 pst = ((g[8].xyz - g[6].xyz) - (g[2].xyz - g[0].xyz)) * 0.25;
-        v = cross(pss, pst) + cross(pst, ptt);
-    } else {
-        vec3 ds0 = g[2].xyz - g[0].xyz, ds1 = g[5].xyz - g[3].xyz, ds2 = g[8].xyz - g[6].xyz;
-        vec3 ts = ((ds0 + ds2) + 4.0 * ds1) * (1.0 / 12.0);
-        vec3 dt0 = g[6].xyz - g[0].xyz, dt1 = g[7].xyz - g[1].xyz, dt2 = g[8].xyz - g[2].xyz;
-        vec3 tt = ((dt0 + dt2) + 4.0 * dt1) * (1.0 / 12.0);
-        v = cross(ts, tt);
+    int cut = q.x == h ? (q.y == 0 ? 0 : (q.y == N ? 1 : -1)) : (q.y == h ? (q.x == 0 ? 2 : (q.x == N ? 3 : -1)) : -1);
+    if (cut >= 0) {
+        sv_frag_out1 = vec4(sv_cut_normal[cut], 0.0);
+        return;
     }
+    vec3 ds0 = g[2].xyz - g[0].xyz, ds1 = g[5].xyz - g[3].xyz, ds2 = g[8].xyz - g[6].xyz;
+    vec3 ts = ((ds0 + ds2) + 4.0 * ds1) * (1.0 / 12.0);
+    vec3 dt0 = g[6].xyz - g[0].xyz, dt1 = g[7].xyz - g[1].xyz, dt2 = g[8].xyz - g[2].xyz;
+    vec3 tt = ((dt0 + dt2) + 4.0 * dt1) * (1.0 / 12.0);
+    vec3 v = cross(ts, tt);
     float len2 = dot(v, v);
     sv_frag_out1 = vec4(len2 > 0.0 ? v * inversesqrt(len2) : vec3(0.0), 0.0);
 }

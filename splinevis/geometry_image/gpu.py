@@ -8,7 +8,12 @@ RGBA32F texture (xyz in rgb; a fourth channel, if any, is subdivided along; miss
   one-sample crop): the padding stays the X-cut padding through the passes, as in the paper, so nothing is
   re-padded between levels;
 * once ``glsl/passes/gi_limit.glsl``: the limit positions ``p^k = E[g^k]`` and the unit normals ``n^k``
-  (``unit(T_s x T_t)``, and ``unit(P_ss x P_st + P_st x P_tt)`` at the four cut vertices).
+  (``unit(T_s x T_t)``; at the four cut vertices the normals ``unit(P_ss x P_st + P_st x P_tt)`` computed
+  once in float64 from the level-0 image, :func:`splinevis.geometry_image.subdivision.cut_normals`, and
+  passed as the uniform ``sv_cut_normal[4]``: in float32 the formula's second differences of ``g^k`` would
+  lose ``4^k`` of the precision).
+
+:func:`curvature_gpu` (``glsl/passes/gi_curvature.glsl``) computes mean and Gaussian curvature per sample.
 
 :func:`geomorph_gpu` (``glsl/passes/gi_geomorph.glsl``) blends two levels for continuous level of detail and
 :func:`displace_gpu` (``glsl/passes/gi_displace.glsl``) applies a scalar displacement map. The float64 twin
@@ -21,33 +26,42 @@ are the paper's masks on :mod:`splinevis.gl.passes`.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..gl.passes import Pass, PassChain
 from .image import _check_n, pad
-from .subdivision import Subdivision
+from .subdivision import Subdivision, cut_normals
 
-__all__ = ["subdivision_passes", "subdivide_gpu", "geomorph_gpu", "displace_gpu"]
+__all__ = ["subdivision_passes", "CurvedSubdivision", "subdivide_gpu", "curvature_gpu", "geomorph_gpu", "displace_gpu"]
 
 SPLIT = "passes/gi_split.glsl"
 AVERAGE = "passes/gi_average.glsl"
 LIMIT = "passes/gi_limit.glsl"
 GEOMORPH = "passes/gi_geomorph.glsl"
 DISPLACE = "passes/gi_displace.glsl"
+CURVATURE = "passes/gi_curvature.glsl"
 
 
-def subdivision_passes(n: int, levels: int) -> list:
+def subdivision_passes(n: int, levels: int, at_cut, *, curvature: bool = False) -> list:
     """The passes that subdivide the padded texture ``"g"`` of an ``n x n`` image ``levels`` times and write
-    the limit positions ``"p"`` and normals ``"n"``: ``L, A`` per level, then the limit pass. The texture
-    ``"g"`` ends as the padded control image of the last level.
+    the limit positions ``"p"`` and normals ``"n"``: ``L, A`` per level, then the limit pass, whose normals
+    at the four cut vertices are ``at_cut`` (``(4, 3)``, :func:`splinevis.geometry_image.subdivision.cut_normals`
+    of the level-0 padded image); with ``curvature`` also the curvature pass, writing ``"k"`` = ``(H, K, 0, 0)``.
+    The texture ``"g"`` ends as the padded control image of the last level.
 
     Examples
     --------
-    >>> [(p.label, p.shape) for p in subdivision_passes(5, 1)]  # doctest: +NORMALIZE_WHITESPACE
+    >>> at_cut = np.eye(3)[[2, 2, 1, 1]]
+    >>> [(p.label, p.shape) for p in subdivision_passes(5, 1, at_cut)]  # doctest: +NORMALIZE_WHITESPACE
     [('passes/gi_split.glsl', (13, 13)), ('passes/gi_average.glsl', (11, 11)),
      ('passes/gi_limit.glsl', (9, 9))]
     """
     _check_n(n)
+    at_cut = np.asarray(at_cut, dtype=np.float64)
+    if at_cut.shape != (4, 3) or not np.isfinite(at_cut).all():
+        raise ValueError(f"at_cut must be the (4, 3) finite normals at the cut vertices, got shape {at_cut.shape}.")
     levels = int(levels)
     if levels < 0:
         raise ValueError(f"levels must be >= 0, got {levels}.")
@@ -57,14 +71,35 @@ def subdivision_passes(n: int, levels: int) -> list:
         passes.append(Pass(SPLIT, {"sv_src": "g"}, "l", shape=(2 * P - 1, 2 * P - 1)))
         passes.append(Pass(AVERAGE, {"sv_src": "l"}, "g", shape=(2 * P - 3, 2 * P - 3)))
         P = 2 * P - 3
-    passes.append(Pass(LIMIT, {"sv_src": "g"}, ("p", "n"), shape=(P - 2, P - 2)))
+    normals = [tuple(float(x) for x in v) for v in at_cut]
+    passes.append(Pass(LIMIT, {"sv_src": "g"}, ("p", "n"), shape=(P - 2, P - 2), uniforms={"sv_cut_normal": normals}))
+    if curvature:
+        passes.append(Pass(CURVATURE, {"sv_src": "g"}, "k", shape=(P - 2, P - 2)))
     return passes
 
 
-def subdivide_gpu(G, levels: int, *, readback: bool = True) -> Subdivision:
+class CurvedSubdivision(NamedTuple):
+    """What :func:`subdivide_gpu` returns with ``curvature=True``: :class:`.subdivision.Subdivision`'s ``p``,
+    ``n``, ``g`` and ``curvature``, ``(m, m, 2)`` float32 ``(H, K)`` (:func:`curvature_gpu`), or the
+    ``(H, K, 0, 0)`` texture.
+
+    Examples
+    --------
+    >>> CurvedSubdivision(*([np.zeros((3, 3, 3))] * 3), np.zeros((3, 3, 2))).curvature.shape
+    (3, 3, 2)
+    """
+
+    p: np.ndarray
+    n: np.ndarray
+    g: np.ndarray
+    curvature: np.ndarray
+
+
+def subdivide_gpu(G, levels: int, *, readback: bool = True, curvature: bool = False):
     """:func:`splinevis.geometry_image.subdivision.subdivide` on the GPU: ``levels`` subdivision steps of the
     geometry image ``G`` (``(n, n, C)``, C = 3 or 4, unpadded; padded here once), then limit positions and
-    normals.
+    normals (at the cut vertices the float64 :func:`splinevis.geometry_image.subdivision.cut_normals` of the
+    level-0 image, rounded to float32).
 
     Parameters
     ----------
@@ -74,10 +109,12 @@ def subdivide_gpu(G, levels: int, *, readback: bool = True) -> Subdivision:
         True: float32 arrays ``p`` ``(m, m, 3)``, ``n`` ``(m, m, 3)`` and the padded control image ``g``
         ``(m + 2, m + 2, C)``, ``m = 2^levels (n - 1) + 1``. False: the three RGBA32F moderngl textures,
         which belong to the caller (use and release them inside :func:`splinevis.gl.context.current`).
+    curvature : bool
+        Also run ``glsl/passes/gi_curvature.glsl`` on the last level (:func:`curvature_gpu`).
 
     Returns
     -------
-    Subdivision
+    Subdivision, or CurvedSubdivision with ``curvature``
 
     Examples
     --------
@@ -89,17 +126,60 @@ def subdivide_gpu(G, levels: int, *, readback: bool = True) -> Subdivision:
     ((33, 33, 3), (33, 33, 3), (35, 35, 3), dtype('float32'))
     >>> bool(np.abs(p - subdivide(G, 2).p).max() < 1e-6)
     True
+    >>> subdivide_gpu(G, 2, curvature=True).curvature.shape
+    (33, 33, 2)
     """
     G = np.asarray(G, dtype=np.float64)
     if G.ndim != 3 or G.shape[2] not in (3, 4):
         raise ValueError(f"subdivide_gpu needs an (n, n, 3) or (n, n, 4) geometry image, got shape {G.shape}.")
     channels = G.shape[2]
-    chain = PassChain(subdivision_passes(G.shape[0], levels))
-    out = chain.run({"g": pad(G, 1)}, result=("p", "n", "g"), readback=readback)
+    Gp = pad(G, 1)
+    chain = PassChain(subdivision_passes(G.shape[0], levels, cut_normals(Gp), curvature=curvature))
+    out = chain.run({"g": Gp}, result=("p", "n", "g", "k") if curvature else ("p", "n", "g"), readback=readback)
+    kind = CurvedSubdivision if curvature else Subdivision
     if not readback:
-        return Subdivision(*out)
-    p, n, g = out
-    return Subdivision(p[..., :3], n[..., :3], g[..., :channels])
+        return kind(*out)
+    p, n, g = out[:3]
+    return kind(p[..., :3], n[..., :3], g[..., :channels], *(k[..., :2] for k in out[3:]))
+
+
+def curvature_gpu(Gp, *, readback: bool = True):
+    """:func:`splinevis.geometry_image.subdivision.curvature` on the GPU (``glsl/passes/gi_curvature.glsl``):
+    mean ``H`` and Gaussian ``K`` at the interior samples of a padded control image, with the cut vertices'
+    stand-in values (the mean of their four closed-mesh neighbours; not the surface's curvature there).
+
+    Parameters
+    ----------
+    Gp : (Q, Q, C) array, or an RGBA32F moderngl texture (e.g. ``subdivide_gpu(G, k, readback=False).g``)
+        A padded control image, xyz in channels 0-2.
+    readback : bool
+        True: ``(H, K)``, two float32 ``(Q - 2, Q - 2)`` arrays; False: the RGBA32F texture holding
+        ``(H, K, 0, 0)`` (the caller's).
+
+    Examples
+    --------
+    >>> from splinevis.geometry_image.image import apply_cut_constraint, image_uv, octahedral_to_sphere
+    >>> from splinevis.geometry_image.subdivision import curvature, subdivide
+    >>> G = apply_cut_constraint(octahedral_to_sphere(image_uv(17)))
+    >>> H, K = curvature_gpu(subdivide_gpu(G, 2).g)
+    >>> H.shape, H.dtype, bool((H < 0).all() and (K > 0).all())  # outward normals: H < 0 on a sphere
+    ((65, 65), dtype('float32'), True)
+    >>> bool(np.abs(H - curvature(subdivide(G, 2).g)[0]).max() < 1e-3)
+    True
+    """
+    g = _check_grid(Gp, "Gp")
+    if isinstance(g, np.ndarray):
+        if g.ndim != 3 or not 3 <= g.shape[2] <= 4:
+            raise ValueError(f"curvature_gpu needs a padded (Q, Q, 3) or (Q, Q, 4) image, got shape {g.shape}.")
+        _check_n(g.shape[0] - 2)
+        g = g.astype(np.float32)
+        Q = g.shape[0]
+    else:
+        Q = g.size[0]
+        _check_n(Q - 2)
+    step = Pass(CURVATURE, {"sv_src": "g"}, "k", shape=(Q - 2, Q - 2))
+    out = PassChain([step]).run({"g": g}, readback=readback)
+    return (out[..., 0], out[..., 1]) if readback else out
 
 
 def _check_grid(a, name: str):

@@ -22,6 +22,13 @@ The closed surface is the uniform bicubic B-spline ``P(s, t)`` whose control poi
   appendix) ``P_ss``, ``P_st``, ``P_tt`` are coplanar and near the vertex
   ``P_s x P_t = s^2 P_ss x P_st + s t P_ss x P_tt + t^2 P_st x P_tt`` is a definite quadratic form times
   the normal, so the normal there is ``unit(P_ss x P_st + P_st x P_tt)`` (:func:`second_derivatives`).
+  It is one surface point with one normal at every level, so :func:`subdivide` computes the four normals
+  once from the level-0 image (:func:`cut_normals`) and uses them at every level (as the GPU does: the
+  formula's second differences lose ``4^k`` of float32's precision at level ``k``).
+* :func:`curvature` mean ``H`` and Gaussian ``K`` from the first and second fundamental forms, with the
+  sign convention of the NURBS programs (:func:`splinevis.nurbs.surface.fundamental_curvature`,
+  ``glsl/programs/nurbs.glsl``): second derivatives dotted with the normal ``unit(T_s x T_t)``, so a
+  sphere with outward normals has ``H = -1/r`` and ``K = 1/r^2``.
 
 Continuous level of detail (sec. 5): :func:`subsample` (negative subdivision), :func:`linear_subdivide`
 and :func:`geomorph` on the triangulation whose diagonals all join ``(r, c)`` and ``(r + 1, c + 1)``
@@ -37,7 +44,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .image import _check_n, cut_vertices, pad
+from .image import _check_n, cut_neighbours, cut_vertices, pad
 
 __all__ = [
     "split",
@@ -45,7 +52,9 @@ __all__ = [
     "limit",
     "tangents",
     "second_derivatives",
+    "cut_normals",
     "normals",
+    "curvature",
     "Subdivision",
     "subdivide",
     "subsample",
@@ -181,10 +190,40 @@ def _unit(v) -> np.ndarray:
     return np.divide(v, norm, out=np.zeros_like(v), where=norm > 0.0)
 
 
-def normals(Gp) -> np.ndarray:
+def _xyz(Gp, what: str) -> np.ndarray:
+    g = _image(Gp)
+    if g.ndim != 3 or g.shape[2] < 3:
+        raise ValueError(f"{what} need xyz in channels 0-2 of a (Q, Q, C) image, got shape {g.shape}.")
+    _check_n(g.shape[0] - 2)
+    return g[..., :3]
+
+
+def cut_normals(Gp) -> np.ndarray:
+    """``(4, 3)``: the unit normals ``unit(P_ss x P_st + P_st x P_tt)`` at the four cut vertices of a padded
+    geometry image, in the order of :func:`splinevis.geometry_image.image.cut_vertices` (see the module
+    docstring). The same surface point at every level of subdivision, so the same normal (in exact
+    arithmetic the level-``k`` value is the level-0 one: its second derivatives are ``4^-k`` times theirs).
+
+    Examples
+    --------
+    >>> from splinevis.geometry_image.image import apply_cut_constraint, image_uv, octahedral_to_sphere, pad
+    >>> G = pad(apply_cut_constraint(octahedral_to_sphere(image_uv(9))))
+    >>> (cut_normals(G).round(12) + 0.0).tolist()  # -Z, +Z, +Y, -Y: outward
+    [[0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]
+    """
+    g = _xyz(Gp, "cut normals")
+    out = np.empty((4, 3))
+    for i, (r, c) in enumerate(cut_vertices(g.shape[0] - 2)):
+        pss, pst, ptt = second_derivatives(g[r:r + 3, c:c + 3])
+        out[i] = _cross(pss[0, 0], pst[0, 0]) + _cross(pst[0, 0], ptt[0, 0])
+    return _unit(out)
+
+
+def normals(Gp, at_cut=None) -> np.ndarray:
     """Unit normals ``unit(T_s x T_t)`` at the interior samples of a padded geometry image (channels 0-2 are
-    xyz), ``(Q, Q, C)`` -> ``(Q - 2, Q - 2, 3)``; at the four cut vertices ``unit(P_ss x P_st + P_st x P_tt)``
-    (see the module docstring). A zero vector gives a zero normal.
+    xyz), ``(Q, Q, C)`` -> ``(Q - 2, Q - 2, 3)``; at the four cut vertices ``at_cut`` (``(4, 3)``, in
+    :func:`splinevis.geometry_image.image.cut_vertices` order), by default this level's
+    :func:`cut_normals`. A zero vector gives a zero normal.
 
     Examples
     --------
@@ -196,17 +235,63 @@ def normals(Gp) -> np.ndarray:
     >>> bool(((nrm * p).sum(axis=-1) > 0.5).all()), bool(np.allclose(np.linalg.norm(nrm, axis=-1), 1.0))
     (True, True)
     """
-    g = _image(Gp)
-    if g.ndim != 3 or g.shape[2] < 3:
-        raise ValueError(f"normals need xyz in channels 0-2 of a (Q, Q, C) image, got shape {g.shape}.")
-    g = g[..., :3]
-    _check_n(g.shape[0] - 2)
+    g = _xyz(Gp, "normals")
     ts, tt = tangents(g)
+    v = _unit(_cross(ts, tt))
+    cv = cut_vertices(g.shape[0] - 2)
+    at_cut = cut_normals(g) if at_cut is None else np.asarray(at_cut, dtype=np.float64)
+    if at_cut.shape != (4, 3):
+        raise ValueError(f"at_cut must be the (4, 3) normals at the cut vertices, got shape {at_cut.shape}.")
+    v[cv[:, 0], cv[:, 1]] = at_cut
+    return v
+
+
+def curvature(Gp) -> tuple[np.ndarray, np.ndarray]:
+    """Mean ``H`` and Gaussian ``K`` curvature at the interior samples of a padded geometry image,
+    ``(Q, Q, C)`` -> two ``(Q - 2, Q - 2)`` arrays.
+
+    With ``T_s, T_t`` (:func:`tangents`), ``P_ss, P_st, P_tt`` (:func:`second_derivatives`),
+    ``v = T_s x T_t``, ``D = v . v`` (``= EG - F^2``, without its cancellation) and ``n = v / sqrt(D)``:
+    ``E, F, G = T_s . T_s, T_s . T_t, T_t . T_t``, ``L, M, N = P_ss . n, P_st . n, P_tt . n``,
+    ``H = (E N - 2 F M + G L) / (2 D)``, ``K = (L N - M^2) / D`` [DoCarmo1976, sec. 3-3]. Invariant under
+    the parametrization, so the same numbers at every level. Sign: that of the NURBS programs (module
+    docstring): ``H < 0`` where the surface bends away from its normal, ``H = -1/r`` on a sphere with outward
+    normals.
+
+    At the four cut vertices ``T_s = T_t = 0``: the first fundamental form is singular and the surface's
+    curvature there is unbounded in general [Losasso2003, appendix]. What is returned there is NOT the
+    surface's curvature but a finite stand-in (so colour maps have no holes): the mean of the values at the
+    cut vertex's four neighbours in the closed mesh
+    (:func:`splinevis.geometry_image.image.cut_neighbours`, the samples of the centroid constraint), at this
+    level, summed as ``((a + b) + (c + d)) / 4``. Elsewhere ``D = 0`` (a degenerate image) gives NaN.
+
+    Examples
+    --------
+    The unit sphere's octahedral image: bicubic, so close to (not exactly) ``H = -1``, ``K = 1``:
+
+    >>> from splinevis.geometry_image.image import apply_cut_constraint, image_uv, octahedral_to_sphere, pad
+    >>> g = pad(apply_cut_constraint(octahedral_to_sphere(image_uv(33))))
+    >>> H, K = curvature(average(split(g)))
+    >>> H.shape, bool((H < 0).all() and (K > 0).all()), round(float(H[32, 32]), 2), round(float(K[32, 32]), 2)
+    ((65, 65), True, -1.05, 1.1)
+    """
+    g = _xyz(Gp, "curvatures")
+    ts, tt = tangents(g)
+    pss, pst, ptt = second_derivatives(g)
     v = _cross(ts, tt)
-    for r, c in cut_vertices(g.shape[0] - 2):
-        pss, pst, ptt = second_derivatives(g[r:r + 3, c:c + 3])
-        v[r, c] = _cross(pss[0, 0], pst[0, 0]) + _cross(pst[0, 0], ptt[0, 0])
-    return _unit(v)
+    D = (v * v).sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = v / np.sqrt(D)[..., None]
+        E, F, G = (ts * ts).sum(axis=-1), (ts * tt).sum(axis=-1), (tt * tt).sum(axis=-1)
+        L, M, N = (pss * n).sum(axis=-1), (pst * n).sum(axis=-1), (ptt * n).sum(axis=-1)
+        H = (E * N - 2.0 * F * M + G * L) / (2.0 * D)
+        K = (L * N - M * M) / D
+    m = g.shape[0] - 2
+    for (r, c), nb in zip(cut_vertices(m), cut_neighbours(m)):
+        for a in (H, K):
+            v4 = a[nb[:, 0], nb[:, 1]]
+            a[r, c] = ((v4[0] + v4[1]) + (v4[2] + v4[3])) / 4.0
+    return H, K
 
 
 class Subdivision(NamedTuple):
@@ -227,7 +312,8 @@ class Subdivision(NamedTuple):
 
 def subdivide(G, levels: int) -> Subdivision:
     """``levels`` steps ``g^{k+1} = A[L[g^k]]`` of the geometry image ``G`` (``(n, n, C)``, unpadded; padded
-    once here), then ``p^k = E[g^k]`` and ``n^k`` (:func:`normals`) [Losasso2003, sec. 5].
+    once here), then ``p^k = E[g^k]`` and ``n^k`` (:func:`normals`, with the cut vertices' normals from the
+    level-0 image: :func:`cut_normals`) [Losasso2003, sec. 5].
 
     Examples
     --------
@@ -241,9 +327,10 @@ def subdivide(G, levels: int) -> Subdivision:
     if levels < 0:
         raise ValueError(f"levels must be >= 0, got {levels}.")
     g = pad(np.asarray(G, dtype=np.float64), 1)
+    at_cut = cut_normals(g)
     for _ in range(levels):
         g = average(split(g))
-    return Subdivision(limit(g), normals(g), g)
+    return Subdivision(limit(g), normals(g, at_cut), g)
 
 
 def subsample(p, j: int) -> np.ndarray:

@@ -102,7 +102,16 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 33, stripes: int = 12
 
 
 def accuracy_figure(path, rows):
-    """Distance to the exact surface and normal error against triangles, one line per method (section b)."""
+    """Distance to the exact surface and normal error against triangles, one line per method (section b).
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> rows = [{"method": m, "triangles": t, "distance_max": 1.0 / t, "normal_rms_deg": 100.0 / t}
+    ...         for m in ("input mesh", "geometry image 9x9") for t in (128, 512)]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     accuracy_figure(Path(d) / "a.png", rows).stat().st_size > 0
+    True
+    """
     plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     methods = list(dict.fromkeys(r["method"] for r in rows))
@@ -123,7 +132,15 @@ def accuracy_figure(path, rows):
 
 
 def fairness_figure(path, rows):
-    """Distance to the input and normal error against the fairness weight (section d)."""
+    """Distance to the input and normal error against the fairness weight (section d).
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> rows = [{"fairness": f, "hausdorff": 1e-3 * (1 + f), "normal_rms_deg": 1.0 / (1 + f)} for f in (0.0, 0.1, 1.0)]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     fairness_figure(Path(d) / "f.png", rows).stat().st_size > 0
+    True
+    """
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     lam = [max(r["fairness"], 1e-4) for r in rows]
@@ -138,7 +155,18 @@ def fairness_figure(path, rows):
 
 
 def lod_figure(path, image, rows, levels=None):
-    """Renders at continuous levels from the octahedron up, with edges, and the distance against level."""
+    """Renders at continuous levels from the octahedron up, with edges, and the distance against level.
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from splinevis.geometry_image.image import image_uv, octahedral_to_sphere
+    >>> from splinevis.geometry_image.model import GeometryImage
+    >>> gi = GeometryImage(octahedral_to_sphere(image_uv(9)), constrain=True)
+    >>> rows = [{"level": -2.0, "distance_max": 0.1}, {"level": 0.0, "distance_max": 0.01}]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     lod_figure(Path(d) / "l.png", gi, rows, levels=[-2.0, 0.0]).stat().st_size > 0
+    True
+    """
     from ..geometry_image.program import min_level, surface_mesh
 
     lo = min_level(image.n)
