@@ -7,6 +7,8 @@ Genus-0 shapes (each a ``pyvista.PolyData`` of triangles, outward oriented) buil
 * :func:`star_blob`: the star-shaped surface ``x = rho(d) d`` over unit directions ``d`` with
   ``rho(d) = 1 + eps * Y(d)`` (a smooth bump function), whose exact unit normal :func:`star_blob_normals` gives;
 * :func:`stretched_blob`: the star blob scaled 4 x 1 x 1 (long thin features: a parametrization's stretch test).
+* :func:`bent_blob`: a long ellipsoid bent into a "C", not star-shaped: projecting it from its centroid onto
+  a sphere folds it (a parametrization must not start that way).
 
 Bad inputs, each failing one check: :func:`torus_mesh` (genus 1), :func:`open_cup` (a border),
 :func:`two_spheres` (two components), :func:`nonmanifold_edge` (an edge in four triangles).
@@ -20,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "star_blob_normals", "stretched_blob", "torus_mesh",
-           "open_cup", "two_spheres", "nonmanifold_edge"]
+__all__ = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "star_blob_normals", "stretched_blob", "bent_blob",
+           "torus_mesh", "open_cup", "two_spheres", "nonmanifold_edge"]
 
 
 def _poly(points, tri):
@@ -124,6 +126,25 @@ def stretched_blob(level: int = 3):
     """
     P, F = _icosphere(level)
     return _poly(P * _bump(P, 0.25)[:, None] * [4.0, 1.0, 1.0], F)
+
+
+def bent_blob(level: int = 3, half_length: float = 2.4, r: float = 0.45):
+    """The ellipsoid with semi-axes ``half_length, r, r`` bent into a "C": its point ``(x, y, z)`` goes to
+    ``((1 - y) cos x, (1 - y) sin x, z)``, the long axis wrapped on the unit circle over the angles
+    ``[-half_length, half_length]`` (a Jacobian determinant ``1 - y > 0``: still outward). With the defaults the
+    "C" spans 275 degrees and its centroid lies in the C's hollow, outside the surface, so projecting the
+    surface from it onto a sphere folds it: the test of a parametrization that does not rely on a star shape.
+
+    >>> m = bent_blob(level=2)
+    >>> d = m.points - m.points.mean(axis=0)
+    >>> tri = m.faces.reshape(-1, 4)[:, 1:]
+    >>> det = np.einsum("ij,ij->i", d[tri[:, 0]], np.cross(d[tri[:, 1]], d[tri[:, 2]]))
+    >>> bool((det < 0).sum() > 0.1 * len(tri))  # central projection flips many triangles
+    True
+    """
+    P, F = _icosphere(level)
+    x, y, z = (P * [half_length, r, r]).T
+    return _poly(np.column_stack([(1.0 - y) * np.cos(x), (1.0 - y) * np.sin(x), z]), F)
 
 
 def torus_mesh(R: float = 1.0, r: float = 0.35, n: int = 24):

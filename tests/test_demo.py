@@ -11,7 +11,8 @@ pytestmark = pytest.mark.gl
 
 def test_showcase_figures_are_written_and_show_something(tmp_path):
     written = render_showcase(tmp_path, progress=False)
-    assert set(written) == {"composite", "composite_check", "effects", "terrain", "volume", "nurbs"}
+    assert set(written) == {"composite", "composite_check", "effects", "terrain", "volume", "nurbs",
+                            "geometry_image"}
     for name, path in written.items():
         img = np.asarray(Image.open(path).convert("RGB")).astype(int)
         non_white = ~np.all(img > 245, axis=-1)

@@ -4,7 +4,8 @@ octahedral geometry image, evaluated by subdivision passes on the GPU.
 The data path, one module per stage:
 
 * :mod:`.validate` -- is the mesh closed, manifold, connected, of genus 0 (which check fails, where);
-* :mod:`.sphere` -- a bijective spherical parametrization with its stretch;
+* :mod:`.sphere` -- a bijective spherical parametrization with its stretch (:mod:`.stretch` the energy,
+  :mod:`.mobius` the centering);
 * :mod:`.image` -- the octahedral layout: the map, the X-cut's padding rules, the cut vertices;
 * :mod:`.fit` -- least-squares fitting with fairness (the cut vertices eliminated as centroids);
 * :mod:`.model` -- :class:`GeometryImage`, the bicubic surface in float64 (the reference);

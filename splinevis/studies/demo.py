@@ -9,6 +9,10 @@
   caster, the quadratic and the cubic spline ray-cast per pixel; second row with reflection lines.
 * ``terrain.png`` -- a synthetic DEM (UTM-sized origin) as a C1 quartic spline: colour by height with
   reflection lines, beside the same data as a linear mesh and as the C2 box spline.
+* ``nurbs.png`` -- NURBS surfaces per fragment with zebra stripes beside tessellated meshes.
+* ``geometry_image.png`` -- a closed mesh (a bent blob, not star-shaped), its spherical parametrization, the
+  unfolded octahedron, its geometry image, the smooth surface subdivided by GPU passes and its reflection
+  lines [Losasso2003].
 """
 
 from __future__ import annotations
@@ -115,7 +119,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _effect_panels()
-    steps = progress_bar(total=5 + len(panels), desc="showcase", enabled=progress, unit="fig")
+    steps = progress_bar(total=6 + len(panels), desc="showcase", enabled=progress, unit="fig")
     written = {}
 
     pl, patch, _ = composite_scene()
@@ -171,6 +175,10 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     from .nurbs_demo import nurbs_figure
 
     written["nurbs"] = nurbs_figure(out / "nurbs.png")
+    steps.update()
+    from .geometry_image_figures import pipeline_figure
+
+    written["geometry_image"] = pipeline_figure(out / "geometry_image.png", n=33)
     steps.update()
     steps.close()
     return written

@@ -1,0 +1,494 @@
+"""Spherical parametrization of a closed genus-0 triangle mesh: the first step of a smooth geometry image
+[Losasso2003, sec. 3], which parametrizes the mesh on the unit sphere as Praun and Hoppe do (E. Praun, H. Hoppe:
+Spherical parametrization and remeshing, 2003) before mapping the sphere to the octahedral image.
+
+The map sends each mesh vertex to a unit vector, each mesh triangle to the spherical triangle on those vectors.
+It is built in three stages, each of which keeps it one-to-one:
+
+1. **A bijective start: Tutte embedding and stereographic projection.** The star of one vertex ``v`` is cut
+   out (the vertex of largest area whose ring has no chord, :func:`_start_vertices`; the next such vertex if the
+   start fails the check below); the rest is a disk, embedded in the plane with its border (the ring of ``v``)
+   on a circle and every inner vertex the weighted mean of its neighbours, with Floater's mean-value weights
+   (M. S. Floater: Mean value coordinates, 2003). The weights are positive and the border strictly convex, so
+   the embedding is one-to-one (W. T. Tutte: How to draw a graph, 1963; M. S. Floater: One-to-one piecewise
+   linear mappings over triangulations, 2003) and close to conformal. The inverse stereographic projection puts
+   the disk on the sphere and ``v`` at the north pole; lines go to circles, so the images of the disk's
+   triangles (circular-arc triangles) and of the star tile the sphere once, and the flat triangles on the same
+   vertices do too unless a triangle is large against the arcs' bulge, which the check below would catch.
+2. **Möbius centering** (:mod:`.mobius`): a conformal start crowds most of the surface into a small part of the
+   sphere; the Möbius transformation that puts the area-weighted centroid of the vertex images at the origin
+   spreads it out, keeping the map conformal and one-to-one.
+3. **Stretch relaxation.** The L2 stretch of the map from the sphere to the mesh (P. V. Sander, J. Snyder,
+   S. J. Gortler, H. Hoppe: Texture mapping progressive meshes, 2001), the energy Praun and Hoppe minimize,
+   measured on spherical triangle areas (:mod:`.stretch`), grows without bound as a spherical triangle
+   degenerates, so descending it keeps the triangles apart. The descent is L-BFGS (J. Nocedal: Updating
+   quasi-Newton matrices with limited storage, 1980) on the tangent planes, the points put back on the sphere
+   after each step, with :meth:`.stretch.StretchEnergy.preconditioner` as the initial inverse Hessian
+   (factored every 4th step). A step must lower the energy (Armijo); where it would flip a triangle it is
+   halved for that triangle's vertices until none flips (:func:`_safe_step`).
+
+The result is checked, not assumed, to be one-to-one: no triangle may have ``det[a, b, c] <= 0`` (they are
+outward oriented), and the spherical triangles' areas must sum to ``4 pi``. That sum is ``4 pi`` times the map's
+degree, so it tells a one-to-one map from one wrapping the sphere twice without flipping a triangle; the
+tolerance :data:`AREA_TOLERANCE` is far above rounding (``~1e-16`` per triangle) and far below the ``4 pi``
+between degrees.
+
+The stretch reported is normalized as Sander et al. do it, so that 1 is the optimum (:mod:`.stretch`).
+
+Why our own code: no Python library ships a spherical parametrization; this one is a few sparse solves (scipy)
+on libigl's mass matrix and cotangent entries, and numpy.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .mobius import center_on_sphere
+from .stretch import StretchEnergy
+from .validate import check_genus0
+
+__all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE"]
+
+#: Largest accepted ``|sum of spherical triangle areas - 4 pi|`` (see the module docstring).
+AREA_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class SphericalMap:
+    """A one-to-one map of a closed genus-0 triangle mesh onto the unit sphere, made by
+    :func:`spherical_parametrization`: vertex ``i`` goes to ``sphere[i]``, each triangle to the spherical
+    triangle on its vertices' images.
+
+    Attributes
+    ----------
+    points : (V, 3) float64
+        The mesh's vertices.
+    faces : (F, 3) int64
+        Its triangles, outward oriented.
+    sphere : (V, 3) float64
+        The unit vectors the vertices go to.
+    stretch : dict
+        The map's L2 stretch and area distortion (:func:`spherical_parametrization`).
+    flipped : int
+        Triangles with ``det[a, b, c] <= 0`` on the sphere: 0.
+    timings : dict
+        Seconds per stage.
+
+    The arrays are read-only.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.closed_meshes import sphere_mesh
+    >>> smap = spherical_parametrization(sphere_mesh(level=1), iterations=0)
+    >>> smap.sphere.shape, smap.faces.dtype, smap.flipped, smap.sphere.flags.writeable
+    ((42, 3), dtype('int64'), 0, False)
+    """
+
+    points: np.ndarray
+    faces: np.ndarray
+    sphere: np.ndarray
+    stretch: dict = field(default_factory=dict)
+    flipped: int = 0
+    timings: dict = field(default_factory=dict)
+
+
+def _frozen(a, dtype):
+    a = np.array(a, dtype=dtype, copy=True)
+    a.flags.writeable = False
+    return a
+
+
+def _unit(x):
+    return x / np.linalg.norm(x, axis=-1, keepdims=True)
+
+
+def _det(X, F):
+    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
+    return np.einsum("ij,ij->i", a, np.cross(b, c))
+
+
+def _spherical_area_sum(X, F):
+    """Sum of the signed areas of the spherical triangles (A. Van Oosterom, J. Strackee: The solid angle of a
+    plane triangle, 1983): ``tan(A / 2) = det[a, b, c] / (1 + a.b + b.c + c.a)``."""
+    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
+    num = np.einsum("ij,ij->i", a, np.cross(b, c))
+    den = 1.0 + np.einsum("ij,ij->i", a, b) + np.einsum("ij,ij->i", b, c) + np.einsum("ij,ij->i", c, a)
+    return float(2.0 * np.arctan2(num, den).sum())
+
+
+# ------------------------------------------------------------------------------------- stage 1: the start
+def _mean_value_weights(P, F):
+    """Sparse ``(V, V)`` mean-value weights ``w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|`` (a, b the angles at
+    ``i`` beside edge ``ij``); ``tan(t/2) = |u x w| / (|u||w| + u.w)`` is positive for every proper triangle."""
+    from scipy.sparse import coo_matrix
+
+    rows, cols, vals = [], [], []
+    for k in range(3):
+        i, j, l = F[:, k], F[:, (k + 1) % 3], F[:, (k + 2) % 3]
+        u, w = P[j] - P[i], P[l] - P[i]
+        nu, nw = np.linalg.norm(u, axis=1), np.linalg.norm(w, axis=1)
+        half = np.linalg.norm(np.cross(u, w), axis=1) / (nu * nw + np.einsum("ij,ij->i", u, w))
+        rows += [i, i]
+        cols += [j, l]
+        vals += [half / nu, half / nw]
+    n = len(P)
+    return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)).tocsr()
+
+
+def _ring(F, v):
+    """The ring of vertex ``v`` as an ordered cycle (each star triangle ``(v, a, b)`` gives ``a -> b``)."""
+    star = F[(F == v).any(axis=1)]
+    star = np.array([np.roll(t, -int(np.flatnonzero(t == v)[0])) for t in star])
+    nxt = dict(zip(star[:, 1].tolist(), star[:, 2].tolist()))
+    ring = [int(star[0, 1])]
+    while len(ring) < len(star):
+        ring.append(nxt[ring[-1]])
+    return np.array(ring, dtype=np.int64)
+
+
+def _start_vertices(F, mass, count=5, search=500):
+    """Up to ``count`` vertices to cut out (of the ``search`` of largest area, largest first), each with a
+    chordless ring: no edge joins two ring vertices that are not ring neighbours. A chord ``ac`` of the ring
+    would make triangles like ``abc`` with all three vertices on the circle, whose flat triangles on a small
+    circle of the sphere face the wrong way."""
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    found = 0
+    for v in np.argsort(-mass, kind="stable")[:search]:
+        ring = _ring(F, int(v))
+        if np.isin(edges, ring).all(axis=1).sum() == 2 * len(ring):  # each edge is in two triangles
+            yield int(v)
+            found += 1
+            if found == count:
+                return
+
+
+def _tutte_sphere(P, F, mass, v):
+    """Stage 1: the Tutte embedding of the mesh minus the star of ``v``, then the inverse stereographic
+    projection (``v`` at the north pole)."""
+    from scipy.sparse import diags
+    from scipy.sparse.linalg import spsolve
+
+    n = len(P)
+    ring = _ring(F, v)
+    arc = np.linalg.norm(P[np.roll(ring, -1)] - P[ring], axis=1)
+    angle = 2 * np.pi * np.concatenate([[0.0], np.cumsum(arc)[:-1]]) / arc.sum()
+    W = _mean_value_weights(P, F)
+    L = (diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
+    inner = np.ones(n, dtype=bool)
+    inner[ring] = False
+    inner[v] = False
+    I = np.flatnonzero(inner)
+    u = np.zeros((n, 2))
+    u[ring] = np.column_stack([np.cos(angle), np.sin(angle)])
+    rhs = -(L[I][:, ring] @ u[ring])
+    u[I] = spsolve(L[I][:, I].tocsc(), rhs)
+    disk = ~(F == v).any(axis=1)
+    e1, e2 = u[F[disk, 1]] - u[F[disk, 0]], u[F[disk, 2]] - u[F[disk, 0]]
+    if (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum() < 0:
+        u[:, 1] = -u[:, 1]
+    # scale so that half the surface lies inside the unit circle: the southern hemisphere
+    r = np.linalg.norm(u, axis=1)
+    order = np.argsort(r[inner])
+    half = np.searchsorted(np.cumsum(mass[inner][order]), 0.5 * mass[inner].sum())
+    u /= max(r[inner][order][min(half, order.size - 1)], 1e-300)
+    r2 = (u * u).sum(axis=1)
+    # inverse stereographic projection from the north pole, mirrored in y: counter-clockwise in the plane is
+    # outward on the sphere
+    X = np.column_stack([2 * u[:, 0], -2 * u[:, 1], r2 - 1.0]) / (r2 + 1.0)[:, None]
+    X[v] = [0.0, 0.0, 1.0]
+    return _unit(X)
+
+
+# ------------------------------------------------------------------------- stage 3: stretch relaxation
+def _safe_step(X, d, lam, F, incident):
+    """``unit(X + lam d)`` with per-vertex steps ``lam`` (changed in place) such that no triangle is flipped: the
+    vertices of flipped triangles halve their step, then only the triangles around them are checked again. A
+    vertex halved 40 times stops (step 0); a triangle whose three vertices stop is as in ``X``, unflipped, so
+    this ends."""
+    Y = _unit(X + lam[:, None] * d)
+    halved = np.zeros(len(X), dtype=np.int64)
+    faces = np.arange(len(F))
+    while True:
+        bad = faces[_det(Y, F[faces]) <= 0.0]
+        if not bad.size:
+            return Y
+        moved = np.unique(F[bad])
+        halved[moved] += 1
+        lam[moved] = np.where(halved[moved] > 40, 0.0, 0.5 * lam[moved])
+        Y[moved] = _unit(X[moved] + lam[moved, None] * d[moved])
+        faces = np.unique(incident[moved].indices)
+
+
+def _tangent(v, X):
+    return v - np.einsum("ij,ij->i", v, X)[:, None] * X
+
+
+def _relax(X, S, iterations, progress, tol, memory=8):
+    """Stage 3: descent of the stretch energy on the sphere, never flipping a triangle: L-BFGS directions
+    (J. Nocedal: Updating quasi-Newton matrices with limited storage, 1980) on the tangent planes, with the
+    preconditioner as the initial inverse Hessian. A step that does not lower the energy enough (Armijo) is
+    halved; where it would flip a triangle it is halved for that triangle's vertices (:func:`_safe_step`)."""
+    from scipy.sparse.linalg import splu
+
+    F = S.F
+    incident = (S.gather @ _corner_face(len(F))).tocsr()  # vertex -> its triangles
+    E, g, sph = S.gradient(X)
+    g = _tangent(g, X)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=iterations, desc="stretch relaxation", unit="step")
+    steps, history, energies = 0, [], [E]
+    for _ in range(iterations):
+        if steps % 4 == 0:  # the preconditioner changes slowly: factor it every 4th step
+            lu = splu(S.preconditioner(sph))
+        # two-loop recursion
+        q = g.copy()
+        alphas = []
+        for s_k, y_k, rho in reversed(history):
+            a = rho * np.vdot(s_k, q)
+            q -= a * y_k
+            alphas.append(a)
+        r = lu.solve(q)
+        if history:
+            s_k, y_k, _ = history[-1]
+            r *= np.vdot(s_k, y_k) / max(np.vdot(y_k, lu.solve(y_k)), 1e-300)
+        for (s_k, y_k, rho), a in zip(history, reversed(alphas)):
+            r += (a - rho * np.vdot(y_k, r)) * s_k
+        d = -_tangent(r, X)
+        slope = float(np.vdot(g, d))
+        if slope >= 0 or not np.isfinite(slope):
+            history = []
+            d = -_tangent(lu.solve(g), X)
+            slope = float(np.vdot(g, d))
+            if slope >= 0:
+                break
+        if history:
+            step = 1.0
+        else:  # no curvature pairs yet: minimize the quadratic model along d (its curvature from a small step)
+            eps = 1e-4 / max(np.abs(d).max(), 1e-300)
+            curv = float(np.vdot(_tangent(S.gradient(_unit(X + eps * d))[1], X) - g, d)) / eps
+            step = -slope / curv if curv > 0 else 1.0
+        step = min(step, 0.5 / np.linalg.norm(d, axis=1).max())  # no vertex moves more than half a radian
+        accepted = False
+        for _ in range(40):
+            Y = _safe_step(X, d, np.full(len(X), step), F, incident)
+            E_new = S.energy(Y)
+            if E_new <= E + 1e-4 * step * slope:
+                accepted = True
+                break
+            step *= 0.5
+        if bar is not None:
+            bar.update(1)
+        if not accepted:
+            break
+        steps += 1
+        energies.append(E_new)
+        E, g_new, sph = S.gradient(Y)
+        g_new = _tangent(g_new, Y)
+        s_k, y_k = Y - X, g_new - _tangent(g, Y)
+        sy = np.vdot(s_k, y_k)
+        if sy > 1e-12 * np.vdot(s_k, s_k) ** 0.5 * np.vdot(y_k, y_k) ** 0.5:
+            history = (history + [(s_k, y_k, 1.0 / sy)])[-memory:]
+        X, g = Y, g_new
+        if len(energies) > 5 and energies[-6] - E < 5 * tol * E:  # under tol a step over the last 5 steps
+            break
+    if bar is not None:
+        bar.close()
+    return X, steps
+
+
+def _corner_face(F):
+    """``(3 F, F)`` sparse: corner ``3 t + k`` belongs to triangle ``t``."""
+    from scipy.sparse import coo_matrix
+
+    return coo_matrix((np.ones(3 * F), (np.arange(3 * F), np.repeat(np.arange(F), 3))), shape=(3 * F, F))
+
+
+# --------------------------------------------------------------------------------------------- the pipeline
+def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200, tol: float = 1e-4,
+                              progress: bool = False) -> SphericalMap:
+    """Map the closed genus-0 triangle mesh ``mesh`` (a ``pyvista.PolyData`` of outward triangles) one-to-one
+    onto the unit sphere with low L2 stretch (module docstring); return a :class:`SphericalMap`.
+
+    Parameters
+    ----------
+    mesh : pyvista.PolyData
+        Checked first by :func:`~splinevis.geometry_image.validate.check_genus0`, whose
+        :class:`~splinevis.errors.MeshTopologyError` names the failed check (and ``name``).
+    name : str
+        The mesh's name in messages.
+    iterations : int
+        Most steps of the stretch relaxation (0: the centered conformal start).
+    tol : float
+        The relaxation stops once its last 5 steps lowered the energy by less than ``5 tol`` of it (or no step
+        lowers it).
+    progress : bool
+        Show a tqdm progress bar over the relaxation's steps.
+
+    ``stretch`` holds the L2 stretch of the map from the sphere to the mesh, normalized so that 1 is the optimum
+    (module docstring): ``"l2"`` over the mesh (at least 1); ``"l2_max"`` and ``"l2_p95"`` over its triangles,
+    ``sqrt(|J_t|^2 / 2)`` normalized alike (below 1: a triangle with more than its share of the sphere);
+    ``"area_ratio_max"`` and ``"area_ratio_p95"`` of ``max(r, 1/r)``, ``r`` a triangle's share of the mesh's area
+    over its share of the sphere's; ``"l2_start"``, ``"l2"`` before the relaxation; ``"steps"``, its steps.
+    ``timings`` has the seconds of ``"validate"``, ``"tutte"``, ``"mobius"``, ``"relax"``, ``"check"`` and
+    ``"total"``. A map that fails the final one-to-one check raises ``RuntimeError`` (never seen on our meshes:
+    each stage keeps the map one-to-one; the check guards against lost precision).
+
+    Examples
+    --------
+    >>> from datasets_synthetic.closed_meshes import stretched_blob
+    >>> smap = spherical_parametrization(stretched_blob(level=2), name="blob")
+    >>> smap.flipped, bool(np.allclose(np.linalg.norm(smap.sphere, axis=1), 1.0))
+    (0, True)
+    >>> bool(1.0 <= smap.stretch["l2"] < smap.stretch["l2_start"])
+    True
+    """
+    import igl
+
+    t0 = time.perf_counter()
+    timings = {}
+    check_genus0(mesh, name)
+    P = np.asarray(mesh.points, dtype=np.float64)
+    F = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 4)[:, 1:]  # all triangles: checked
+    timings["validate"] = time.perf_counter() - t0
+
+    mass = igl.massmatrix(P, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    timings["tutte"] = timings["mobius"] = 0.0
+    failure = f"{name}: no vertex has a chordless ring to cut the mesh open at."
+    for v in _start_vertices(F, mass):  # the next candidate if the start is not one-to-one (lost precision)
+        t = time.perf_counter()
+        X = _tutte_sphere(P, F, mass, v)
+        timings["tutte"] += time.perf_counter() - t
+        t = time.perf_counter()
+        X = center_on_sphere(X, mass)
+        timings["mobius"] += time.perf_counter() - t
+        try:
+            _check_one_to_one(X, F, name, f"the Tutte start cut at vertex {v}")
+            break
+        except RuntimeError as err:
+            failure = str(err)
+    else:
+        raise RuntimeError(failure)
+
+    t = time.perf_counter()
+    S = StretchEnergy(P, F)
+    start = S.report(X)["l2"]
+    X, steps = _relax(X, S, int(iterations), bool(progress), float(tol))
+    timings["relax"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    _check_one_to_one(X, F, name, "the relaxed map")
+    stretch = {**S.report(X), "l2_start": start, "steps": steps}
+    timings["check"] = time.perf_counter() - t
+    timings["total"] = time.perf_counter() - t0
+    return SphericalMap(points=_frozen(P, np.float64), faces=_frozen(F, np.int64), sphere=_frozen(X, np.float64),
+                        stretch=stretch, flipped=int((_det(X, F) <= 0).sum()), timings=timings)
+
+
+def _check_one_to_one(X, F, name, what):
+    flipped = int((_det(X, F) <= 0).sum())
+    area = _spherical_area_sum(X, F)
+    if flipped or abs(area - 4 * np.pi) > AREA_TOLERANCE:
+        raise RuntimeError(f"{name}: {what} is not one-to-one: {flipped} flipped triangles, spherical area "
+                           f"{area:.12g} against 4 pi = {4 * np.pi:.12g}.")
+
+
+# -------------------------------------------------------------------------------------------- point location
+def locate(sphere_map, directions, *, k: int = 8, tol: float = 1e-12):
+    """The spherical triangle of ``sphere_map`` containing each direction, and the barycentric coordinates of
+    the direction's ray's crossing with that flat triangle.
+
+    Parameters
+    ----------
+    sphere_map : SphericalMap
+    directions : array_like, (N, 3) or (3,)
+        Any nonzero lengths.
+    k : int
+        Candidates first tried per direction: the triangles with the ``k`` nearest centroids; the directions
+        none contains are tried again with ``4 k``, ``16 k``, ... up to all triangles.
+    tol : float
+        A barycentric coordinate down to ``-tol`` counts as inside (directions on edges and vertices).
+
+    Returns
+    -------
+    face : (N,) int64
+    bary : (N, 3) float64
+        Sum 1, each at least ``-tol``: ``bary @ sphere[faces[face]]`` is along the direction and
+        ``bary @ points[faces[face]]`` the mesh point (:func:`surface_points`).
+
+    A direction ``q`` is in triangle ``abc`` (``det[a, b, c] > 0``) when ``q = alpha a + beta b + gamma c``
+    with ``alpha, beta, gamma >= 0``; ``alpha = det[q, b, c] / det[a, b, c]`` and alike, so the barycentrics are
+    ``(det[q, b, c], det[a, q, c], det[a, b, q])`` over their sum, which must be positive (else ``q`` is on the
+    far side). Of the candidates the one with the largest smallest coordinate wins. A direction no triangle
+    contains (the map is not one-to-one) raises ``ValueError``.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.closed_meshes import sphere_mesh
+    >>> smap = spherical_parametrization(sphere_mesh(level=1), iterations=0)
+    >>> face, bary = locate(smap, [[0.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    >>> face.shape, bool(np.allclose(bary.sum(axis=1), 1.0) and (bary >= -1e-12).all())
+    ((2,), True)
+    """
+    from scipy.spatial import cKDTree
+
+    q = np.atleast_2d(np.asarray(directions, dtype=np.float64))
+    length = np.linalg.norm(q, axis=1) if q.ndim == 2 and q.shape[1] == 3 else None
+    if length is None or not (np.isfinite(length).all() and (length > 0).all()):
+        raise ValueError(f"directions must be finite nonzero 3-vectors, shape (N, 3); got shape {q.shape}.")
+    q = q / length[:, None]
+    X, F = sphere_map.sphere, sphere_map.faces
+    tree = cKDTree(_unit(X[F].sum(axis=1)))
+    face = np.full(len(q), -1, dtype=np.int64)
+    bary = np.zeros((len(q), 3))
+    for start in range(0, len(q), 1 << 15):  # bounded memory: (chunk, k, 3) arrays
+        chunk = slice(start, start + (1 << 15))
+        face[chunk], bary[chunk] = _locate_in(X, F, tree, q[chunk], int(k), float(tol))
+    return face, bary
+
+
+def _locate_in(X, F, tree, q, k, tol):
+    face = np.full(len(q), -1, dtype=np.int64)
+    bary = np.zeros((len(q), 3))
+    todo = np.arange(len(q))
+    kk = min(k, len(F))
+    while todo.size:
+        cand = tree.query(q[todo], k=kk)[1].reshape(len(todo), kk)
+        a, b, c = (X[F[cand, i]] for i in range(3))
+        Q = np.broadcast_to(q[todo][:, None, :], a.shape)
+        w = np.stack([np.einsum("nki,nki->nk", Q, np.cross(b, c)), np.einsum("nki,nki->nk", a, np.cross(Q, c)),
+                      np.einsum("nki,nki->nk", a, np.cross(b, Q))], axis=2)
+        total = w.sum(axis=2, keepdims=True)
+        w = np.where(total > 0, w / np.where(total > 0, total, 1.0), -np.inf)
+        best = np.argmax(w.min(axis=2), axis=1)
+        rows = np.arange(len(todo))
+        found = w[rows, best].min(axis=1) >= -tol
+        face[todo[found]] = cand[rows, best][found]
+        bary[todo[found]] = w[rows, best][found]
+        todo = todo[~found]
+        if todo.size and kk == len(F):
+            raise ValueError(f"{todo.size} directions, like {q[todo[0]].tolist()}, are in no spherical triangle "
+                             "(is the map one-to-one?).")
+        kk = min(4 * kk, len(F))
+    return face, bary
+
+
+def surface_points(sphere_map, directions) -> np.ndarray:
+    """The mesh points the spherical map sends to ``directions`` (``(N, 3)``, any nonzero lengths):
+    ``bary @ points[faces[face]]`` with :func:`locate`'s triangles and barycentrics (the inverse map, linear on
+    each triangle along the rays).
+
+    Examples
+    --------
+    >>> from datasets_synthetic.closed_meshes import ellipsoid_mesh
+    >>> smap = spherical_parametrization(ellipsoid_mesh(level=1), iterations=0)
+    >>> bool(np.allclose(surface_points(smap, smap.sphere), smap.points, atol=1e-12))
+    True
+    """
+    face, bary = locate(sphere_map, directions)
+    return np.einsum("ni,nij->nj", bary, sphere_map.points[sphere_map.faces[face]])
