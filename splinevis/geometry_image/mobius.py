@@ -6,8 +6,7 @@ For ``|c| < 1`` the map ``x -> (1 - |c|^2) (x + c) / |x + c|^2 + c`` sends the u
 orientation of every triangle; it fixes ``-c / |c|`` and ``c / |c|``, stretching lengths by
 ``(1 + |c|) / (1 - |c|)`` at the first and shrinking them by its inverse at the second. A conformal map of a
 surface to the sphere is unique up to these (and rotations), so among them we pick the one that puts the
-surface's area-weighted centroid of the images at the origin (the normalization of A. Baden, K. Crane,
-M. Kazhdan: Möbius registration, 2018): it undoes the crowding of a stereographic projection.
+surface's area-weighted centroid of the images at the origin (the normalization of [Baden2018]): it undoes the crowding of a stereographic projection.
 
 At ``c = 0`` the centroid ``mu(c) = sum_i w_i x_i(c)`` has the derivative ``2 (I - sum_i w_i x_i x_i^T)`` (from
 ``d x_i / dc = 2 (I - x_i x_i^T)``), so :func:`center_on_sphere` takes Newton steps, each a new transformation of

@@ -1,6 +1,5 @@
 """Spherical parametrization of a closed genus-0 triangle mesh: the first step of a smooth geometry image
-[Losasso2003, sec. 3], which parametrizes the mesh on the unit sphere as Praun and Hoppe do (E. Praun, H. Hoppe:
-Spherical parametrization and remeshing, 2003) before mapping the sphere to the octahedral image.
+[Losasso2003, sec. 3], which parametrizes the mesh on the unit sphere as Praun and Hoppe do [PraunHoppe2003] before mapping the sphere to the octahedral image.
 
 The map sends each mesh vertex to a unit vector, each mesh triangle to the spherical triangle on those vectors.
 It is built in three stages, each of which keeps it one-to-one:
@@ -9,20 +8,17 @@ It is built in three stages, each of which keeps it one-to-one:
    out (the vertex of largest area whose ring has no chord, :func:`_start_vertices`; the next such vertex if the
    start fails the check below); the rest is a disk, embedded in the plane with its border (the ring of ``v``)
    on a circle and every inner vertex the weighted mean of its neighbours, with Floater's mean-value weights
-   (M. S. Floater: Mean value coordinates, 2003). The weights are positive and the border strictly convex, so
-   the embedding is one-to-one (W. T. Tutte: How to draw a graph, 1963; M. S. Floater: One-to-one piecewise
-   linear mappings over triangulations, 2003) and close to conformal. The inverse stereographic projection puts
+   [Floater2003]. The weights are positive and the border strictly convex, so
+   the embedding is one-to-one [Tutte1963; Floater2003b] and close to conformal. The inverse stereographic projection puts
    the disk on the sphere and ``v`` at the north pole; lines go to circles, so the images of the disk's
    triangles (circular-arc triangles) and of the star tile the sphere once, and the flat triangles on the same
    vertices do too unless a triangle is large against the arcs' bulge, which the check below would catch.
 2. **Möbius centering** (:mod:`.mobius`): a conformal start crowds most of the surface into a small part of the
    sphere; the Möbius transformation that puts the area-weighted centroid of the vertex images at the origin
    spreads it out, keeping the map conformal and one-to-one.
-3. **Stretch relaxation.** The L2 stretch of the map from the sphere to the mesh (P. V. Sander, J. Snyder,
-   S. J. Gortler, H. Hoppe: Texture mapping progressive meshes, 2001), the energy Praun and Hoppe minimize,
+3. **Stretch relaxation.** The L2 stretch of the map from the sphere to the mesh [Sander2001], the energy Praun and Hoppe minimize,
    measured on spherical triangle areas (:mod:`.stretch`), grows without bound as a spherical triangle
-   degenerates, so descending it keeps the triangles apart. The descent is L-BFGS (J. Nocedal: Updating
-   quasi-Newton matrices with limited storage, 1980) on the tangent planes, the points put back on the sphere
+   degenerates, so descending it keeps the triangles apart. The descent is L-BFGS [Nocedal1980] on the tangent planes, the points put back on the sphere
    after each step, with :meth:`.stretch.StretchEnergy.preconditioner` as the initial inverse Hessian
    (factored every 4th step). A step must lower the energy (Armijo); where it would flip a triangle it is
    halved for that triangle's vertices until none flips (:func:`_safe_step`).
@@ -111,8 +107,7 @@ def _det(X, F):
 
 
 def _spherical_area_sum(X, F):
-    """Sum of the signed areas of the spherical triangles (A. Van Oosterom, J. Strackee: The solid angle of a
-    plane triangle, 1983): ``tan(A / 2) = det[a, b, c] / (1 + a.b + b.c + c.a)``."""
+    """Sum of the signed areas of the spherical triangles [VanOosterom1983]: ``tan(A / 2) = det[a, b, c] / (1 + a.b + b.c + c.a)``."""
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
     num = np.einsum("ij,ij->i", a, np.cross(b, c))
     den = 1.0 + np.einsum("ij,ij->i", a, b) + np.einsum("ij,ij->i", b, c) + np.einsum("ij,ij->i", c, a)
@@ -228,7 +223,7 @@ def _tangent(v, X):
 
 def _relax(X, S, iterations, progress, tol, memory=8):
     """Stage 3: descent of the stretch energy on the sphere, never flipping a triangle: L-BFGS directions
-    (J. Nocedal: Updating quasi-Newton matrices with limited storage, 1980) on the tangent planes, with the
+    [Nocedal1980] on the tangent planes, with the
     preconditioner as the initial inverse Hessian. A step that does not lower the energy enough (Armijo) is
     halved; where it would flip a triangle it is halved for that triangle's vertices (:func:`_safe_step`)."""
     from scipy.sparse.linalg import splu

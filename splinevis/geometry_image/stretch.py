@@ -1,9 +1,8 @@
 """The L2 stretch of a map of a triangle mesh onto the unit sphere, as the energy the spherical
 parametrization descends (:mod:`.sphere`), with its gradient and a preconditioner.
 
-The stretch is that of the map from the sphere to the mesh (P. V. Sander, J. Snyder, S. J. Gortler, H. Hoppe:
-Texture mapping progressive meshes, 2001), the energy Praun and Hoppe minimize for spherical parametrizations
-(E. Praun, H. Hoppe: Spherical parametrization and remeshing, 2003): over the mesh triangles ``P_t``,
+The stretch is that of the map from the sphere to the mesh [Sander2001], the energy Praun and Hoppe minimize for spherical
+parametrizations [PraunHoppe2003]: over the mesh triangles ``P_t``,
 ``E = sum_t area(P_t) |J_t|_F^2 / 2``, ``J_t`` the linear map from the triangle on the sphere to ``P_t``: that
 of the flat triangle ``Q_t`` on the three unit vectors, scaled to the spherical triangle's area,
 ``|J_t|^2 = |J_flat|^2 area(Q_t) / area_sphere(Q_t)``. Sander et al.'s per-triangle stretch is
@@ -14,8 +13,7 @@ ratios vary, scores ``1 + O(h^4)`` for edges ``h``: 1.3e-6 above 1 on ``sphere_m
 
 Why the spherical area: with the flat one alone, three points near one great circle make a sliver of no
 spherical area but of some flat area, and a descent learns to make such slivers. The spherical area,
-``2 atan2(det[a, b, c], 1 + a.b + b.c + c.a)`` (A. Van Oosterom, J. Strackee: The solid angle of a plane
-triangle, 1983), goes to 0 as a triangle degenerates, so ``E`` grows without bound, and sums to ``4 pi`` over
+``2 atan2(det[a, b, c], 1 + a.b + b.c + c.a)`` [VanOosterom1983], goes to 0 as a triangle degenerates, so ``E`` grows without bound, and sums to ``4 pi`` over
 a one-to-one map whatever the triangles do.
 
 The preconditioner: at a similarity of scale ``s`` the energy's Hessian is the mesh's cotangent stiffness times

@@ -1,7 +1,7 @@
 """What users have today beside a smooth geometry image: the raw mesh and its Loop and Catmull-Clark subdivisions,
 measured the same way at equal triangle counts (the geometry-image study, section b).
 
-* **Loop** and **Catmull-Clark** subdivision come from MeshLab (pymeshlab's ``meshing_surface_subdivision_loop``
+* **Loop** [Loop1987] and **Catmull-Clark** [CatmullClark1978] subdivision come from MeshLab (pymeshlab's ``meshing_surface_subdivision_loop``
   and ``meshing_surface_subdivision_catmull_clark``; a triangle mesh becomes quads after the first Catmull-Clark
   step, returned triangulated), **Loop (VTK)** from ``vtkLoopSubdivisionFilter``. Their vertices are not moved to
   the limit surface, and their normals are what a user gets: averaged from the triangles
