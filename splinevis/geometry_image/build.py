@@ -24,7 +24,7 @@ from .fit import fit_geometry_image
 from .measure import surface_distance
 from .model import GeometryImage
 
-__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays"]
+__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "FOLDED_WARNING"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -49,6 +49,10 @@ class BuildReport:
         units of the mesh's bounding-box diagonal; empty when not measured.
     fit_rms : float
         The fit's residual at its samples (diagonal units).
+    folded : float
+        Fraction of the measured limit mesh's triangles that face against the surface normals at their corners
+        (:func:`folded_fraction`): ripples folding over where the parametrization undersamples the mesh; NaN
+        when not measured.
 
     Examples
     --------
@@ -67,6 +71,26 @@ class BuildReport:
     stretch: dict = field(default_factory=dict)
     distance: dict = field(default_factory=dict)
     fit_rms: float = float("nan")
+    folded: float = float("nan")
+
+
+#: Above this fraction of folded limit triangles, :func:`geometry_image_from_mesh` warns.
+FOLDED_WARNING = 1e-3
+
+
+def folded_fraction(points, normals, faces) -> float:
+    """Fraction of triangles whose orientation (``(b - a) x (c - a)``) points against the sum of the unit normals
+    at their corners: where a fitted surface ripples so much that it folds over (degenerate triangles, e.g. at
+    the cut vertices, do not count).
+
+    >>> import numpy as np
+    >>> P = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]); up = np.tile([0.0, 0, 1], (3, 1))
+    >>> folded_fraction(P, up, np.array([[0, 1, 2]])), folded_fraction(P, -up, np.array([[0, 1, 2]]))
+    (0.0, 1.0)
+    """
+    P, N, F = (np.asarray(a) for a in (points, normals, faces))
+    orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    return float((np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0).mean())
 
 
 def limit_mesh_arrays(image: GeometryImage, level: int):
@@ -159,14 +183,22 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
     fit = fit_geometry_image(None, n, fairness=fairness, oversample=oversample, samples=samples)
     seconds["fit"] = time.perf_counter() - t0
 
-    distance = {}
+    distance, folded = {}, float("nan")
     if measure:
         t0 = time.perf_counter()
-        P, _, F = limit_mesh_arrays(fit.image, levels_finer)
+        P, N, F = limit_mesh_arrays(fit.image, levels_finer)
         distance = surface_distance(P, F, smap.points, smap.faces)
+        folded = folded_fraction(P, N, F)
         seconds["measure"] = time.perf_counter() - t0
+        if folded > FOLDED_WARNING:
+            import warnings
+
+            warnings.warn(f"the geometry image of {name} folds over in {100 * folded:.2g}% of its limit triangles: the "
+                          f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
+                          f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; a larger n "
+                          "or fairness reduces the ripples.", stacklevel=2)
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
-                         stretch, distance, fit.rms)
+                         stretch, distance, fit.rms, folded)
     return fit.image, report

@@ -178,7 +178,7 @@ def render_showcase(out_dir, *, progress=True) -> dict:
     steps.update()
     from .geometry_image_figures import pipeline_figure
 
-    written["geometry_image"] = pipeline_figure(out / "geometry_image.png", n=33)
+    written["geometry_image"] = pipeline_figure(out / "geometry_image.png")
     steps.update()
     steps.close()
     return written

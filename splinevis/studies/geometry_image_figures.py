@@ -39,7 +39,7 @@ def _mesh(points, faces):
     return pv.PolyData(np.asarray(points, dtype=np.float64), faces=pv.CellArray.from_regular_cells(np.asarray(faces)))
 
 
-def pipeline_figure(path, *, quick: bool = False, n: int = 33, stripes: int = 12):
+def pipeline_figure(path, *, quick: bool = False, n: int = 65, stripes: int = 12):
     """Mesh -> sphere -> octahedron -> geometry image -> smooth surface -> reflection lines, for the bent blob (not
     star-shaped: central projection would fold it)."""
     from datasets_synthetic.closed_meshes import bent_blob
@@ -51,7 +51,11 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 33, stripes: int = 12
 
     mesh = bent_blob(level=3 if quick else 4)
     smap = spherical_parametrization(mesh, name="bent blob")
-    image, report = geometry_image_from_mesh(mesh, n, name="bent blob")
+    import warnings
+
+    with warnings.catch_warnings():  # the folded fraction is in the title
+        warnings.simplefilter("ignore")
+        image, report = geometry_image_from_mesh(mesh, n, name="bent blob")
     height = np.asarray(mesh.points)[:, 2]
     panels = []
     panels.append(("1. input mesh, %s triangles" % f"{mesh.n_cells:,}",
@@ -96,8 +100,9 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 33, stripes: int = 12
         ax.set_title(title, fontsize=10)
         ax.set_xticks([])
         ax.set_yticks([])
-    fig.suptitle("Smooth geometry image of a bent blob [Losasso2003]: hausdorff %.1e of the diagonal"
-                 % report.distance["hausdorff"], fontsize=11)
+    fig.suptitle("Smooth geometry image of a bent blob [Losasso2003]: Hausdorff distance %.1e of the diagonal; "
+                 "%.1f%% of the limit triangles fold over where the parametrization undersamples the inner bend"
+                 % (report.distance["hausdorff"], 100 * report.folded), fontsize=11)
     return save_figure(fig, path, dpi=90)
 
 
