@@ -52,3 +52,10 @@ def test_every_shape_is_bijective_c1_and_close(shape):
 def test_bad_inputs_fail_with_their_check(bad, check):
     with pytest.raises(MeshTopologyError, match=f"^{check}: {bad}"):
         geometry_image_from_mesh(getattr(cm, bad)(), 9, name=bad)
+
+
+def test_a_mesh_file_is_read(tmp_path):
+    path = tmp_path / "blob.ply"
+    cm.star_blob(level=2).save(path)
+    image, report = geometry_image_from_mesh(path, 17)
+    assert report.name == str(path) and report.triangles == 320 and image.n == 17

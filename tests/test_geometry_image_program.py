@@ -150,3 +150,27 @@ def test_bad_meshes_get_clear_errors():
             pl.add_geometry_image(torus_mesh(n=8), n=9)
     finally:
         pl.close()
+
+
+@pytest.mark.gl
+def test_curvature_and_isophotes_on_the_smooth_surface():
+    """The program computes curvature only when the scene shows it, with the NURBS program's sign (H < 0 on an
+    outward convex surface: blue in the diverging map), and isophotes draw bands on the exact normals."""
+    image, _ = geometry_image_from_mesh(star_blob(level=3), n=17, measure=False)
+    built = PROGRAM.make(image, splinevis.Style(lights=1), level=1)
+    assert "curvature" not in built.point_data
+    curved = PROGRAM.make(image, splinevis.Style(output="curvature", curvature_scale=2.0), level=1)
+    H, K = np.asarray(curved.point_data["curvature"]).T
+    assert np.median(H) < 0 and np.median(K) > 0
+    shots = {}
+    for name, style in (("curvature", dict(output="curvature", curvature_scale=2.0)), ("isophotes", dict(isophotes=6))):
+        pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+        pl.add_geometry_image(image, level=1, **style)
+        pl.camera_position = [(3.0, -4.0, 2.5), (0, 0, 0), (0, 0, 1)]
+        shown = pl.depth_buffer() < 1
+        shots[name] = (pl.screenshot().astype(int), shown)
+        pl.close()
+    img, shown = shots["curvature"]
+    assert (img[shown][:, 2] > img[shown][:, 0]).mean() > 0.9  # blue: negative mean curvature
+    img, shown = shots["isophotes"]
+    assert img[shown].std() > 30  # bands, not a flat shade
