@@ -15,6 +15,9 @@ Cases
   peak MB (own process); ``cold_start``: seconds from a new process to the models and the first picture.
 * ``terrain``: the terrain ray caster on 65x65 .. 1025x1025 grids in one full-screen view, with the
   min/max hierarchy on and off (the hierarchical equivalent of the front-to-back occlusion sets of [Reis2008, sec. VII]).
+* ``profile``: where a full-screen C1 terrain frame's time goes (``bench_profile.py``): the full program, shading
+  replaced by a constant, the hierarchy walk alone and a reference ray march, in fragments/s and per llvmpipe
+  thread (new processes at ``LP_NUM_THREADS=1`` and ``2``), with the per-fragment work counters of a debug build.
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -232,6 +235,10 @@ def _markdown(results):
              [("view", text), ("program", text), ("min ms", num), ("median ms", num), ("median / marching cubes", num)],
              lambda r: [r["view"], r["program"], f"{r['min_ms']:.1f}", f"{r['median_ms']:.1f}",
                         f"{r['ratio_to_mesh']:.1f}"])
+    if "profile" in results:
+        from bench_profile import profile_markdown
+
+        lines.append(profile_markdown(results["profile"]))
     return "\n".join(lines) + "\n"
 
 
@@ -249,10 +256,12 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    from bench_profile import bench_profile
     from bench_scale import bench_cold_start, bench_large_terrain
 
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
-             ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start)]
+             ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
+             ("profile", bench_profile)]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

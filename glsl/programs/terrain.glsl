@@ -91,6 +91,55 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb, 
     return s == SV_NO_HIT ? SV_NO_HIT : ta + s;
 }
 
+#ifdef SV_DEBUG_RAYMARCH
+// The reference ray march of the benchmarks (debug="raymarch"; benchmarks/bench_profile.py): the same ray in
+// index space and the same box clip, then sv_march_steps fixed steps through the box (no early exit), each
+// reading the coefficient texel of the cell under the sample and comparing the ray's height with its first
+// coefficient (the spline's value at the cell's corner: nearest sampling). Not exact and not a product
+// path: a yardstick for what a plain height-field march costs per fragment and per texel fetch here.
+uniform int sv_march_steps;
+
+bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    hit.curvature = vec2(0.0);
+    hit.depth = 0.0;
+    vec3 P0 = vec3(sv_index_scale * ro.xy + sv_index_shift, ro.z);
+    vec3 D = vec3(sv_index_scale * rd.xy, rd.z);
+    float t = tmin;
+    float t_end = 3.0e38;
+    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
+    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
+    for (int k = 0; k < 3; ++k) {
+        if (abs(D[k]) < 1e-30) {
+            if (P0[k] < blo[k] || P0[k] > bhi[k]) return false;
+        } else {
+            float ta = (blo[k] - P0[k]) / D[k];
+            float tb = (bhi[k] - P0[k]) / D[k];
+            t = max(t, min(ta, tb));
+            t_end = min(t_end, max(ta, tb));
+        }
+    }
+    if (!(t <= t_end)) return false;
+    float dt = (t_end - t) / float(max(sv_march_steps, 1));
+    float t_hit = SV_NO_HIT;
+    ivec2 last = ivec2(sv_ncells) - ivec2(1);
+    bool above = false;  // a hit is a step from above the height to below it (as the exact cast: no walls)
+    for (int s = 0; s < sv_march_steps; ++s) {
+        float ts = t + (float(s) + 0.5) * dt;
+        vec3 p = P0 + ts * D;
+        ivec2 c = clamp(ivec2(floor(p.xy)), ivec2(0), last);
+        float h = sv_coef_texel(sv_table_address(8 * (c.y * int(sv_ncells.x) + c.x))).x;
+        if (p.z > h) above = true;
+        else if (above && t_hit == SV_NO_HIT) t_hit = ts;
+    }
+    if (t_hit == SV_NO_HIT) return false;
+    hit.t = t_hit;
+    hit.pos = ro + t_hit * rd;
+    hit.normal = vec3(0.0, 0.0, 1.0);
+    hit.scalar = P0.z + t_hit * D.z + sv_scalar_offset;
+    hit.uv = (P0.xy + t_hit * D.xy) / sv_ncells;
+    return true;
+}
+#else
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.curvature = vec2(0.0);
     hit.depth = 0.0;
@@ -124,6 +173,9 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     float t_hit = SV_NO_HIT;
     ivec2 cell_hit = ivec2(0);
     for (int s = 0; s < sv_max_steps; ++s) {
+#ifdef SV_DEBUG_COUNTERS
+        sv_count_traversal += 1;
+#endif
         float size = float(1 << L);
         vec2 lo = vec2(c) * size;
         vec2 hi = min(lo + vec2(size), sv_ncells);
@@ -146,6 +198,15 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
                 c = clamp(child, 2 * c, 2 * c + ivec2(1));
                 continue;
             }
+#ifdef SV_DEBUG_TRAVERSAL_ONLY
+            // traversal only (debug="traversal"): the first candidate cell is the hit, at the ray's entry
+            t_hit = t;
+            cell_hit = c;
+            break;
+#endif
+#ifdef SV_DEBUG_COUNTERS
+            sv_count_cells += 1;
+#endif
             float b0[15];
             float b1[15];
             sv_load_cell(c, b0, b1);
@@ -226,3 +287,4 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
 #endif
     return true;
 }
+#endif

@@ -69,6 +69,17 @@ _FS_SURFACE = """
 """
 _FS_LIGHT = """  fragOutput0 = sv_out;
 """
+# The debug build with per-fragment counters (SV_DEBUG_COUNTERS, glsl/lib/core/counters.glsl): a miss is not
+# discarded (its work is counted too) but written at the far plane, so the depth buffer still holds exactly
+# the hits; the colour is the selected counter.
+_FS_COUNTERS = """
+  vec3 sv_ro; vec3 sv_rd; float sv_tmin;
+  sv_pixel_ray(svPosMC, sv_ro, sv_rd, sv_tmin);
+  SvHit sv_hit;
+  bool sv_is_hit = sv_surface_hit(sv_ro, sv_rd, sv_tmin, sv_hit);
+  gl_FragDepth = sv_is_hit ? sv_window_depth(MCDCMatrix, sv_ro + sv_hit.t * sv_rd) : 1.0;
+  vec4 sv_out = sv_counters_color(sv_is_hit);
+"""
 #: Fragment code per program kind (splinevis.gl.contract.KINDS) that becomes a SplineActor.
 _FS_IMPL = {"raycast": _FS_DEPTH, "surface": _FS_SURFACE}
 
@@ -280,7 +291,8 @@ class SplineActor:
         sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
         sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)
         sp.AddFragmentShaderReplacement(_FS_DEC_TAG, True, fs_dec + self.assembled.text, False)
-        sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, _FS_IMPL[kind], False)
+        impl = _FS_COUNTERS if kind == "raycast" and defines.get("SV_DEBUG_COUNTERS") else _FS_IMPL[kind]
+        sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, impl, False)
         sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
         self._textures = {}
         for name, arr in spec.textures.items():

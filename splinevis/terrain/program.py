@@ -20,9 +20,12 @@ from .limits import check_grid_size
 from .model import TerrainSpline
 from .raycast import raycast_terrain
 
-__all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_grid_size", "terrain_depth_bound", "PROGRAM"]
+__all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_grid_size", "terrain_depth_bound",
+           "debug_defines", "DEBUG_MODES", "PROGRAM"]
 
 ROOTS = ("bracketed", "paper")
+#: Debug builds of the program (option ``debug``; none is compiled unless asked for, see :func:`debug_defines`).
+DEBUG_MODES = ("counters", "flat", "restrict", "traversal", "raymarch")
 #: Levels the shader's hierarchy uniforms hold.
 MAX_LEVELS = 16
 
@@ -72,9 +75,57 @@ def hierarchy_table(terrain: TerrainSpline):
     return pack_rgba32f(texels, name="terrain hierarchy table"), offsets, widths
 
 
+def debug_defines(debug: str | None) -> tuple:
+    """Compile-time flags and uniforms of a debug build of the terrain program (``None``: none at all, so the
+    default program's source is unchanged).
+
+    ``"counters"``
+        The fragment writes per-fragment work counts instead of its colour (``glsl/lib/core/counters.glsl``;
+        read them with :func:`splinevis.analysis.profile.fragment_counters`); misses are written at the far
+        plane instead of discarded, so their work is counted too. Uniform ``sv_counter_select``.
+    ``"flat"``
+        Shading replaced by the constant base colour (the hit's normal is then not evaluated either).
+    ``"restrict"``
+        As ``"flat"``, and a triangle whose restricted quartic changes sign is hit at its segment's start: the
+        walk, the coefficient loads, clipping and restriction by blossoming, without the root finder.
+    ``"traversal"``
+        The hierarchy walk only: the first candidate cell (a level-0 cell whose height range the ray meets)
+        is taken as the hit at the ray's entry, no coefficients loaded, no root finding; constant colour.
+    ``"raymarch"``
+        A reference height-field march instead of the exact ray cast: ``sv_march_steps`` fixed steps
+        (uniform, default 64; set ``actor.extra_uniforms["sv_march_steps"]``) through the terrain's box, one
+        coefficient texel read per step; constant colour. For benchmarks only: not exact.
+
+    Examples
+    --------
+    >>> debug_defines(None)
+    ({}, {})
+    >>> debug_defines("traversal")
+    ({'SV_DEBUG_NO_SHADING': True, 'SV_DEBUG_TRAVERSAL_ONLY': True}, {})
+    >>> debug_defines("profile")
+    Traceback (most recent call last):
+    ValueError: debug must be None or one of 'counters', 'flat', 'restrict', 'traversal', 'raymarch'; got 'profile'.
+    """
+    if debug is None:
+        return {}, {}
+    if debug not in DEBUG_MODES:
+        raise ValueError(f"debug must be None or one of {', '.join(map(repr, DEBUG_MODES))}; got {debug!r}.")
+    if debug == "counters":
+        return {"SV_DEBUG_COUNTERS": True}, {"sv_counter_select": 0}
+    defines = {"SV_DEBUG_NO_SHADING": True}
+    if debug == "restrict":
+        defines["SV_DEBUG_NO_ROOTS"] = True
+    if debug == "traversal":
+        defines["SV_DEBUG_TRAVERSAL_ONLY"] = True
+    if debug == "raymarch":
+        defines["SV_DEBUG_RAYMARCH"] = True
+        return defines, {"sv_march_steps": 64}
+    return defines, {}
+
+
 def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: int = 8, max_steps: int | None = None,
                     hierarchy: bool | int = True, roots: str = "bracketed",
-                    rows_per_texture: int = ROWS_PER_TEXTURE) -> ProgramSpec:
+                    rows_per_texture: int = ROWS_PER_TEXTURE, debug: str | None = None) -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
     ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
@@ -82,7 +133,8 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     ``hierarchy``: True walks the full min/max quadtree; False walks cell by cell (level 0 only); an
     int caps the top level (what the benchmarks use to measure the hierarchy's effect).
     ``rows_per_texture``: rows of one texture of the coefficient table (default: 1 GiB textures; smaller
-    values split small tables too, which the tests use to check the split path). ``style`` decides nothing.
+    values split small tables too, which the tests use to check the split path). ``debug``: None (default)
+    or a debug build for profiling (:func:`debug_defines`). ``style`` decides nothing.
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
@@ -99,6 +151,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
+    extra_defines, extra_uniforms = debug_defines(debug)
     check_root_method(roots, ROOTS, degree=4)
     ncy, ncx = terrain.shape
     rows_per_texture = check_degree(rows_per_texture, "rows_per_texture", low=1, high=ROWS_PER_TEXTURE)
@@ -131,7 +184,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         triangles=triangles,
         offset=tuple(off),
         defines={**root_defines(roots), "SV_TERRAIN_SPLIT": len(pieces) > 1, "SV_TERRAIN_SPLIT3": len(pieces) > 2,
-                 "SV_TERRAIN_SPLIT4": len(pieces) > 3, "SV_ROWS_PER_TEXTURE": int(rows_per_texture)},
+                 "SV_TERRAIN_SPLIT4": len(pieces) > 3, "SV_ROWS_PER_TEXTURE": int(rows_per_texture), **extra_defines},
         uniforms={
             "sv_level_offset[]": level_offsets,
             "sv_level_width[]": level_widths,
@@ -145,6 +198,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
             "sv_newton_iterations": iterations,
             "sv_scalar_offset": float(terrain.z_ref),
             "sv_scalar_range": terrain.data_range if terrain.data_range is not None else terrain.zrange,
+            **extra_uniforms,
         },
         textures={"sv_terrain_minmax": table,
                   **{"sv_terrain_coef" + (str(k) if k else ""): piece for k, piece in enumerate(pieces)}},
@@ -184,5 +238,5 @@ def _model_from(heights, scheme: str = "C1", presmooth: int = 0, **read_options)
 PROGRAM = SplineProgram(
     "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
     hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
-    options=("max_steps", "hierarchy", "roots", "rows_per_texture"),
+    options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug"),
     description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")

@@ -20,6 +20,9 @@ struct SvHit {
     float depth;
     vec2 curvature;
 };
+#ifdef SV_DEBUG_COUNTERS
+#include "lib/core/counters.glsl"
+#endif
 
 uniform vec3 sv_eye_mc;       // camera position, model coordinates (perspective views)
 uniform vec3 sv_view_dir_mc;  // unit view direction, model coordinates (parallel views)

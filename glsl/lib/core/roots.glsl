@@ -12,6 +12,9 @@
 // The float64 twins are splinevis.bb.roots.newton_secure and splinevis.bb.roots.first_root_bracketed;
 // they mirror this file line by line.
 #include "lib/core/bernstein.glsl"
+#ifdef SV_DEBUG_COUNTERS
+#include "lib/core/counters.glsl"
+#endif
 
 // Acceptance constant K_n (in units of eps32 = 2^-23) of the residual test |f(x)| <= K_n eps32 S(x),
 // S(x) = sum_k |c_k| B^n_k(x).  Derivation (u = 2^-24 = eps32 / 2):
@@ -69,6 +72,9 @@ float sv_newton_from_starts(float c[5], int n, vec4 x, int iterations) {
     vec4 fp;
     for (int it = 0; it < 8; ++it) {
         if (it < iterations) {
+#ifdef SV_DEBUG_COUNTERS
+            sv_count_root_steps += 1;
+#endif
             sv_bernstein_eval_deriv4(c, n, x, f, fp);
             bvec4 nz = notEqual(fp, vec4(0.0));
             vec4 xn = x - f / mix(vec4(1.0), fp, nz);
@@ -154,6 +160,9 @@ float sv_bracket_newton(float g[5], int m, float lo, float hi, float glo, float 
     // constant bound with a masked body. Callers keep iterations in 1..SV_ROOT_MAX_ITERATIONS.
     for (int it = 0; it < iterations; ++it) {
         {
+#ifdef SV_DEBUG_COUNTERS
+            sv_count_root_steps += 1;
+#endif
             bool from_lo = (sigma != 0.0) ? ((glo < 0.0) == (sigma < 0.0)) : (abs(glo) <= abs(ghi));
             float x = from_lo ? lo : hi;
             float gx = from_lo ? glo : ghi;

@@ -14,6 +14,10 @@ vec3 sv_to_world(vec3 v) {
 #endif
 
 vec4 sv_shade(SvHit h, vec3 rd) {
+#ifdef SV_DEBUG_NO_SHADING
+    // debug builds that time the ray cast alone (splinevis.terrain.program, option debug): a constant colour
+    return vec4(sv_color, 1.0);
+#endif
     vec3 n = normalize(h.normal);
     if (dot(n, rd) > 0.0) n = -n;  // two-sided: the normal faces the viewer
 #if defined(SV_OUT_NORMALS)

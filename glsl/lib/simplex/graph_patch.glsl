@@ -60,6 +60,12 @@ float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz
     float cmin = min(min(min(c[0], c[1]), min(c[2], c[3])), c[4]);
     float cmax = max(max(max(c[0], c[1]), max(c[2], c[3])), c[4]);
     if (cmin > 0.0 || cmax < 0.0) return SV_NO_HIT;
+#ifdef SV_DEBUG_NO_ROOTS
+    return t0;  // debug build without the root finder (terrain option debug="restrict"): the segment's start
+#endif
+#ifdef SV_DEBUG_COUNTERS
+    sv_count_root_calls += 1;
+#endif
     float s = sv_first_root(c, 4, iterations);
     return s < 0.0 ? SV_NO_HIT : mix(t0, t1, s);
 }
