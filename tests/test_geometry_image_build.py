@@ -41,10 +41,16 @@ def test_every_shape_is_bijective_c1_and_close(shape):
     assert report.distance["hausdorff"] < (0.05 if shape == "bent_blob" else 0.01), report.distance
     folds = [w for w in caught if "folds over" in str(w.message)]
     assert bool(folds) == (report.folded > FOLDED_WARNING)
-    if shape == "bent_blob":  # a known weakness: the inner bend is compressed ~13x in area on the sphere
-        assert folds and "undersamples" in str(folds[0].message)
-    else:
+    if shape != "bent_blob":
         assert report.folded < FOLDED_WARNING, report.folded
+
+
+def test_folds_are_reported_and_warned():
+    """A known weakness: the bent blob's inner bend is compressed ~13x in area on the sphere; sampled through the
+    parametrization's own orientation, the fitted surface folds over there and the build says so."""
+    with pytest.warns(UserWarning, match="folds over in .* undersamples part of the mesh") as caught:
+        _, report = geometry_image_from_mesh(cm.bent_blob(level=3), 33, name="bent blob", orientation=None)
+    assert report.folded > FOLDED_WARNING and "bent blob" in str(caught[0].message)
 
 
 @pytest.mark.parametrize("bad, check", [("torus_mesh", "genus 0"), ("open_cup", "manifold edges"),
@@ -59,3 +65,24 @@ def test_a_mesh_file_is_read(tmp_path):
     cm.star_blob(level=2).save(path)
     image, report = geometry_image_from_mesh(path, 17)
     assert report.name == str(path) and report.triangles == 320 and image.n == 17
+
+
+def test_orientation_samples_the_compressed_part_better():
+    """Rotating the sphere so that the most compressed part of the stretched blob lands where the octahedral map
+    samples densest (up to 3 sqrt 3 more image area per sphere area) improves the fit: measured 2.4x closer at
+    n = 33 (asserted: at least 1.5x), and never a worse sampling criterion than the identity."""
+    from splinevis.geometry_image.orient import best_orientation, sampling_criterion
+    from splinevis.geometry_image.sphere import spherical_parametrization
+
+    mesh = cm.stretched_blob(level=3)
+    _, plain = geometry_image_from_mesh(mesh, 33, orientation=None)
+    _, oriented = geometry_image_from_mesh(mesh, 33)
+    assert oriented.distance["hausdorff"] < plain.distance["hausdorff"] / 1.5
+    assert oriented.distance["rms"] < plain.distance["rms"]
+    smap = spherical_parametrization(mesh)
+    R, rows = best_orientation(smap)
+    assert np.allclose(R, oriented.orientation) and np.allclose(R @ R.T, np.eye(3)) and np.linalg.det(R) > 0
+    assert sampling_criterion(smap.points, smap.faces, smap.sphere, R) == min(r["criterion"] for r in rows)
+    assert rows[0]["candidate"] == "identity" and min(r["criterion"] for r in rows) <= rows[0]["criterion"]
+    with pytest.raises(ValueError, match="3x3 rotation"):
+        geometry_image_from_mesh(mesh, 9, orientation=np.diag([1.0, 1.0, -1.0]))

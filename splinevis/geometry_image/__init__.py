@@ -7,6 +7,7 @@ The data path, one module per stage:
 * :mod:`.sphere` -- a bijective spherical parametrization with its stretch (:mod:`.stretch` the energy,
   :mod:`.mobius` the centering);
 * :mod:`.image` -- the octahedral layout: the map, the X-cut's padding rules, the cut vertices;
+* :mod:`.orient` -- which rotation of the sphere the image samples (the compressed part where sampling is dense);
 * :mod:`.fit` -- least-squares fitting with fairness (the cut vertices eliminated as centroids);
 * :mod:`.model` -- :class:`GeometryImage`, the bicubic surface in float64 (the reference);
 * :mod:`.subdivision` -- the masks of subdivision as numpy float64 (the GPU passes' twin and CPU fallback);

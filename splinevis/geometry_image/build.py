@@ -41,7 +41,7 @@ class BuildReport:
     fairness : float
     seconds : dict
         Per stage: ``check``, ``parametrize`` (and the parametrization's own stages as ``parametrize/...``),
-        ``sample``, ``fit``, ``measure``.
+        ``orient``, ``sample``, ``fit``, ``measure``.
     stretch : dict
         The spherical parametrization's stretch (:class:`.sphere.SphericalMap`).
     distance : dict
@@ -49,6 +49,8 @@ class BuildReport:
         units of the mesh's bounding-box diagonal; empty when not measured.
     fit_rms : float
         The fit's residual at its samples (diagonal units).
+    orientation : (3, 3) ndarray
+        The rotation of the sphere the mesh was sampled through.
     folded : float
         Fraction of the measured limit mesh's triangles that face against the surface normals at their corners
         (:func:`folded_fraction`): ripples folding over where the parametrization undersamples the mesh; NaN
@@ -72,6 +74,7 @@ class BuildReport:
     distance: dict = field(default_factory=dict)
     fit_rms: float = float("nan")
     folded: float = float("nan")
+    orientation: np.ndarray = field(default_factory=lambda: np.eye(3))
 
 
 #: Above this fraction of folded limit triangles, :func:`geometry_image_from_mesh` warns.
@@ -111,7 +114,7 @@ def limit_mesh_arrays(image: GeometryImage, level: int):
 
 def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversample: int = 4,
                              name: str = "mesh", measure: bool = True, levels_finer: int = 2, progress: bool = False,
-                             parametrization_options: dict | None = None):
+                             parametrization_options: dict | None = None, orientation="auto"):
     """Build an ``n x n`` smooth geometry image of the closed genus-0 ``mesh`` (module docstring).
 
     Parameters
@@ -135,6 +138,9 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
         Progress bars on the long stages.
     parametrization_options : dict, optional
         Passed to :func:`.sphere.spherical_parametrization`.
+    orientation : "auto", None or (3, 3) array
+        The rotation of the sphere under the octahedron: ``"auto"`` picks the one that samples the most compressed
+        part of the mesh best (:func:`.orient.best_orientation`), None keeps the parametrization's own.
 
     Returns
     -------
@@ -175,8 +181,22 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
     t0 = time.perf_counter()
     from .image import image_uv, octahedral_to_sphere
 
+    if isinstance(orientation, str) and orientation == "auto":
+        from .orient import best_orientation
+
+        R, _ = best_orientation(smap)
+    elif orientation is None:
+        R = np.eye(3)
+    else:
+        R = np.asarray(orientation, dtype=np.float64)
+        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0:
+            raise ValueError(f"orientation must be 'auto', None or a 3x3 rotation matrix, got {orientation!r}.")
+    seconds["orient"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
     M = int(oversample) * (int(n) - 1) + 1
-    samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3)).reshape(M, M, 3)
+    # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
+    samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R).reshape(M, M, 3)
     seconds["sample"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -200,5 +220,5 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
-                         stretch, distance, fit.rms, folded)
+                         stretch, distance, fit.rms, folded, R)
     return fit.image, report

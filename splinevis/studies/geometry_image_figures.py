@@ -60,17 +60,18 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 65, stripes: int = 12
     panels = []
     panels.append(("1. input mesh, %s triangles" % f"{mesh.n_cells:,}",
                    render(lambda pl: pl.add_mesh(mesh, color="tan", show_edges=True, edge_color="gray"))))
-    sphere = _mesh(smap.sphere, smap.faces)
+    R = report.orientation  # the sphere as the image samples it: rotated under the octahedron
+    sphere = _mesh(smap.sphere @ R.T, smap.faces)
     sphere.point_data["z"] = height
     panels.append((f"2. on the sphere (stretch {report.stretch['l2']:.2f}, 0 flipped)",
                    render(lambda pl: pl.add_mesh(sphere, scalars="z", cmap="viridis", show_edges=True,
                                                  edge_color="gray", show_scalar_bar=False))))
-    uv = sphere_to_octahedral(smap.sphere)
+    uv = sphere_to_octahedral(smap.sphere @ R.T)
     edges = np.unique(np.sort(np.concatenate([smap.faces[:, [0, 1]], smap.faces[:, [1, 2]], smap.faces[:, [2, 0]]]),
                               axis=1), axis=0)
     short = np.abs(uv[edges[:, 0]] - uv[edges[:, 1]]).max(axis=1) < 0.25  # not across the X-cut's borders
     M = 257
-    heights = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3))[:, 2].reshape(M, M)
+    heights = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R)[:, 2].reshape(M, M)
     panels.append(("3. octahedron unfolded (X-cut), mesh edges", ("domain", heights, uv, edges[short])))
     G = image.control
     lo, hi = G.reshape(-1, 3).min(axis=0), G.reshape(-1, 3).max(axis=0)
