@@ -18,6 +18,8 @@ Cases
 * ``profile``: where a full-screen C1 terrain frame's time goes (``bench_profile.py``): the full program, shading
   replaced by a constant, the hierarchy walk alone and a reference ray march, in fragments/s and per llvmpipe
   thread (new processes at ``LP_NUM_THREADS=1`` and ``2``), with the per-fragment work counters of a debug build.
+* ``outofcore``: terrain and volume splines built tile by tile on dask and written to zarr
+  (``bench_outofcore.py``): wall time, tiles/s at 1 and 2 workers, disk and peak memory of a fresh process.
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -239,6 +241,10 @@ def _markdown(results):
         from bench_profile import profile_markdown
 
         lines.append(profile_markdown(results["profile"]))
+    if "outofcore" in results:
+        from bench_outofcore import outofcore_markdown
+
+        lines.append(outofcore_markdown(results["outofcore"]))
     return "\n".join(lines) + "\n"
 
 
@@ -256,12 +262,13 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    from bench_outofcore import bench_outofcore
     from bench_profile import bench_profile
     from bench_scale import bench_cold_start, bench_large_terrain
 
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
              ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
-             ("profile", bench_profile)]
+             ("profile", bench_profile), ("outofcore", bench_outofcore)]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

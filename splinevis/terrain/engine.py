@@ -89,7 +89,14 @@ def _apply(z, st: _Stencil):
     lo_x, hi_x, lo_y, hi_y = st.pads()
     zp = _pad_cubic(z, lo_x, hi_x, lo_y, hi_y) if (lo_x or hi_x or lo_y or hi_y) else np.ascontiguousarray(z)
     ny, nx = z.shape
-    ncx, ncy = (nx - 1) // st.step, (ny - 1) // st.step
+    return _apply_padded(zp, st, (ny - 1) // st.step, (nx - 1) // st.step, (lo_x, lo_y))
+
+
+def _apply_padded(zp, st: _Stencil, ncy, ncx, corner, threads=_THREADS):
+    """The cells ``(ncy, ncx)`` of an already padded grid ``zp`` whose cell (0, 0) has its lower-left corner at
+    ``zp[corner[1], corner[0]]`` (the out-of-core tiles call this on a tile plus its halo, ``threads=1``)."""
+    zp = np.ascontiguousarray(zp)
+    lo_x, lo_y = corner
     # Only the stencil points with a nonzero weight are gathered: a sliding window of the padded grid,
     # read through flat indices: cell (i, j)'s corner is (step i + lo_x, step j + lo_y) in the padded grid,
     # its window starts at corner + (x0, y0) (never negative: lo_x >= -x0, lo_y >= -y0).
@@ -116,10 +123,10 @@ def _apply(z, st: _Stencil):
             np.matmul(blk[k:k + sub], W, out=dst[k:k + sub])
 
     starts = range(0, ncy, rows)
-    if ncy * ncx >= 4 * _CHUNK_CELLS and _THREADS > 1:
+    if ncy * ncx >= 4 * _CHUNK_CELLS and threads > 1:
         from concurrent.futures import ThreadPoolExecutor
 
-        with ThreadPoolExecutor(_THREADS) as ex:
+        with ThreadPoolExecutor(threads) as ex:
             list(ex.map(work, starts))
     else:
         for r0 in starts:
