@@ -212,3 +212,19 @@ def test_reflection_lines_keep_their_public_function():
     assert min(counts.values()) > 200, counts
     with pytest.raises(ValueError, match="stripes must be a positive integer"):
         add_mesh_with_reflection_lines(pl, pv.Sphere(), 0)
+
+
+def test_the_callers_mesh_is_not_moved():
+    """The mesh is drawn relative to its centre on a copy with its own points: the caller's mesh (drawn again in
+    another panel, as the showcase does) keeps its coordinates."""
+    import pyvista as pv
+
+    import splinevis
+    from splinevis.gl.mesh_effects import add_mesh_with_reflection_lines
+
+    mesh = pv.Sphere(center=(5.0, -3.0, 2.0))
+    before = np.array(mesh.points, copy=True)
+    pl = splinevis.Plotter(off_screen=True, window_size=(40, 30))
+    add_mesh_with_reflection_lines(pl, mesh, 8)
+    pl.close()
+    np.testing.assert_array_equal(np.asarray(mesh.points), before)

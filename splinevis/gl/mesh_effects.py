@@ -142,8 +142,8 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
     # buffer is off (vertexMC must match the eye), so far from the origin (UTM-sized coordinates) float32 vertices
     # would otherwise lose their digits; the eye goes into the same frame in double precision (camera_frame).
     centre = np.asarray(mesh.center, dtype=np.float64) if mesh.n_points else np.zeros(3)
-    mesh = mesh.copy(deep=False)
-    mesh.points = np.asarray(mesh.points, dtype=np.float64) - centre
+    mesh = mesh.copy(deep=False)  # new vtkPoints on the copy: the caller's mesh keeps its own points
+    mesh.SetPoints(pv.vtk_points(np.asarray(mesh.points, dtype=np.float64) - centre))
     mapper = vtkOpenGLPolyDataMapper()
     mapper.SetInputData(mesh)
     mapper.ScalarVisibilityOff()
