@@ -37,6 +37,29 @@ def _group(path, mode):
     return zarr.open_group(str(path), mode=mode)
 
 
+def _open_store(path, kind: str, what: str, writer: str, scheme):
+    """``(group, attrs, path)`` of the store of ``kind`` at ``path`` opened for reading, with the errors of a
+    missing path, a zarr group of another kind and a store written with another ``scheme`` (None: any);
+    ``what`` names the store in messages ("terrain", "volume") and ``writer`` how to make one."""
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"no {what} store at {str(p)!r}: write one with {writer}(path, {_DATA[what]}, "
+                                f"scheme).")
+    group = _group(p, "r")
+    attrs = dict(group.attrs)
+    if attrs.get("kind") != kind:
+        raise ValueError(f"{str(p)!r} is a zarr group but not a {what} store (kind {attrs.get('kind')!r}); write one "
+                         f"with {writer}.")
+    if scheme is not None and attrs["scheme"] != scheme:
+        raise ValueError(f"the {what} store at {str(p)!r} was written with scheme {attrs['scheme']!r}, not "
+                         f"{scheme!r}: rebuild it with {writer}(path, {_DATA[what]}, {scheme!r}) or open it "
+                         f"without scheme=.")
+    return group, attrs, str(p)
+
+
+_DATA = {"terrain": "heights", "volume": "samples"}
+
+
 def _codecs(compressor):
     """zarr compressors: "lz4" (blosc lz4 with byte shuffle: twice as fast as zarr's default zstd on float64
     coefficients, 15% larger), "zstd" (zarr's default) or None (raw)."""
@@ -191,20 +214,7 @@ def open_terrain_store(path, scheme=None):
     Traceback (most recent call last):
     ValueError: the terrain store at ... was written with scheme 'C2', not 'C1': rebuild it with ...
     """
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"no terrain store at {str(p)!r}: write one with write_terrain_store(path, heights, "
-                                f"scheme).")
-    group = _group(p, "r")
-    attrs = dict(group.attrs)
-    if attrs.get("kind") != _KIND:
-        raise ValueError(f"{str(p)!r} is a zarr group but not a terrain store (kind {attrs.get('kind')!r}); write one "
-                         f"with write_terrain_store.")
-    if scheme is not None and attrs["scheme"] != scheme:
-        raise ValueError(f"the terrain store at {str(p)!r} was written with scheme {attrs['scheme']!r}, not "
-                         f"{scheme!r}: rebuild it with write_terrain_store(path, heights, {scheme!r}) or open it "
-                         f"without scheme=.")
-    return TerrainStore(group, attrs, str(p))
+    return TerrainStore(*_open_store(path, _KIND, "terrain", "write_terrain_store", scheme))
 
 
 class TerrainStore:

@@ -18,13 +18,12 @@ the octree levels above the cubes.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
 from .halo import as_dask_array
 from .schedule import run
-from .store import _codecs, _level0, _store, _upper_levels
+from .store import _codecs, _level0, _open_store, _store, _upper_levels
 from .volume import _coefficients, _cube_ranges, _tiled_padded, _tiles3
 
 __all__ = ["write_volume_store", "open_volume_store", "VolumeStore"]
@@ -112,22 +111,7 @@ def open_volume_store(path, scheme=None):
     Traceback (most recent call last):
     FileNotFoundError: no volume store at '/nonexistent/v.zarr': write one with write_volume_store(path, samples, scheme).
     """
-    import zarr
-
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"no volume store at {str(p)!r}: write one with write_volume_store(path, samples, "
-                                f"scheme).")
-    group = zarr.open_group(str(p), mode="r")
-    attrs = dict(group.attrs)
-    if attrs.get("kind") != _KIND:
-        raise ValueError(f"{str(p)!r} is a zarr group but not a volume store (kind {attrs.get('kind')!r}); write one "
-                         f"with write_volume_store.")
-    if scheme is not None and attrs["scheme"] != scheme:
-        raise ValueError(f"the volume store at {str(p)!r} was written with scheme {attrs['scheme']!r}, not "
-                         f"{scheme!r}: rebuild it with write_volume_store(path, samples, {scheme!r}) or open it "
-                         f"without scheme=.")
-    return VolumeStore(group, attrs, str(p))
+    return VolumeStore(*_open_store(path, _KIND, "volume", "write_volume_store", scheme))
 
 
 class VolumeStore:
