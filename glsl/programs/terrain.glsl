@@ -91,6 +91,26 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb, 
     return s == SV_NO_HIT ? SV_NO_HIT : ta + s;
 }
 
+// The index-space ray P0 + t D from tmin clipped to the terrain's box (cells x height range): [t, t_end], false
+// when the ray misses it.
+bool sv_clip_to_box(vec3 P0, vec3 D, float tmin, out float t, out float t_end) {
+    t = tmin;
+    t_end = 3.0e38;
+    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
+    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
+    for (int k = 0; k < 3; ++k) {
+        if (abs(D[k]) < 1e-30) {
+            if (P0[k] < blo[k] || P0[k] > bhi[k]) return false;
+        } else {
+            float ta = (blo[k] - P0[k]) / D[k];
+            float tb = (bhi[k] - P0[k]) / D[k];
+            t = max(t, min(ta, tb));
+            t_end = min(t_end, max(ta, tb));
+        }
+    }
+    return t <= t_end;
+}
+
 #ifdef SV_DEBUG_RAYMARCH
 // The reference ray march of the benchmarks (debug="raymarch"; benchmarks/bench_profile.py): the same ray in
 // index space and the same box clip, then sv_march_steps fixed steps through the box (no early exit), each
@@ -104,21 +124,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.depth = 0.0;
     vec3 P0 = vec3(sv_index_scale * ro.xy + sv_index_shift, ro.z);
     vec3 D = vec3(sv_index_scale * rd.xy, rd.z);
-    float t = tmin;
-    float t_end = 3.0e38;
-    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
-    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
-    for (int k = 0; k < 3; ++k) {
-        if (abs(D[k]) < 1e-30) {
-            if (P0[k] < blo[k] || P0[k] > bhi[k]) return false;
-        } else {
-            float ta = (blo[k] - P0[k]) / D[k];
-            float tb = (bhi[k] - P0[k]) / D[k];
-            t = max(t, min(ta, tb));
-            t_end = min(t_end, max(ta, tb));
-        }
-    }
-    if (!(t <= t_end)) return false;
+    float t, t_end;
+    if (!sv_clip_to_box(P0, D, tmin, t, t_end)) return false;
     float dt = (t_end - t) / float(max(sv_march_steps, 1));
     float t_hit = SV_NO_HIT;
     ivec2 last = ivec2(sv_ncells) - ivec2(1);
@@ -146,22 +153,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     // The ray in index space: P(t) = P0 + t D (t unchanged).
     vec3 P0 = vec3(sv_index_scale * ro.xy + sv_index_shift, ro.z);
     vec3 D = vec3(sv_index_scale * rd.xy, rd.z);
-    // Clip to the terrain's box.
-    float t = tmin;
-    float t_end = 3.0e38;
-    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
-    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
-    for (int k = 0; k < 3; ++k) {
-        if (abs(D[k]) < 1e-30) {
-            if (P0[k] < blo[k] || P0[k] > bhi[k]) return false;
-        } else {
-            float ta = (blo[k] - P0[k]) / D[k];
-            float tb = (bhi[k] - P0[k]) / D[k];
-            t = max(t, min(ta, tb));
-            t_end = min(t_end, max(ta, tb));
-        }
-    }
-    if (!(t <= t_end)) return false;
+    float t, t_end;
+    if (!sv_clip_to_box(P0, D, tmin, t, t_end)) return false;
 
     // Start in the top-level block holding the entry point (with the full hierarchy that is the single
     // root block; a truncated hierarchy, sv_top_level < last level, starts lower: level 0 is a plain
