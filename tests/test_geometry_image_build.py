@@ -86,3 +86,18 @@ def test_orientation_samples_the_compressed_part_better():
     assert rows[0]["candidate"] == "identity" and min(r["criterion"] for r in rows) <= rows[0]["criterion"]
     with pytest.raises(ValueError, match="3x3 rotation"):
         geometry_image_from_mesh(mesh, 9, orientation=np.diag([1.0, 1.0, -1.0]))
+
+
+def test_a_parametrization_made_already_is_used():
+    """The showcase parametrizes once for its sphere panel and hands it over: the same image as parametrizing
+    inside (the parametrization is deterministic), and a map of another mesh is refused."""
+    from splinevis.geometry_image.sphere import spherical_parametrization
+
+    mesh = cm.star_blob(level=2)
+    smap = spherical_parametrization(mesh)
+    inside, _ = geometry_image_from_mesh(mesh, 9)
+    given, report = geometry_image_from_mesh(mesh, 9, sphere_map=smap)
+    np.testing.assert_array_equal(given.control, inside.control)
+    assert "parametrize" not in report.seconds
+    with pytest.raises(ValueError, match="not a parametrization of mesh"):
+        geometry_image_from_mesh(cm.sphere_mesh(level=2), 9, sphere_map=smap)

@@ -114,7 +114,7 @@ def limit_mesh_arrays(image: GeometryImage, level: int):
 
 def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversample: int = 4,
                              name: str = "mesh", measure: bool = True, levels_finer: int = 2, progress: bool = False,
-                             parametrization_options: dict | None = None, orientation="auto"):
+                             parametrization_options: dict | None = None, orientation="auto", sphere_map=None):
     """Build an ``n x n`` smooth geometry image of the closed genus-0 ``mesh`` (module docstring).
 
     Parameters
@@ -138,6 +138,9 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
         Progress bars on the long stages.
     parametrization_options : dict, optional
         Passed to :func:`.sphere.spherical_parametrization`.
+    sphere_map : SphericalMap, optional
+        This mesh's spherical parametrization, already made (:func:`.sphere.spherical_parametrization`): it is
+        used instead of parametrizing again (its stage times are then not in the report).
     orientation : "auto", None or (3, 3) array
         The rotation of the sphere under the octahedron: ``"auto"`` picks the one that samples the most compressed
         part of the mesh best (:func:`.orient.best_orientation`), None keeps the parametrization's own.
@@ -172,11 +175,16 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
     info = check_genus0(mesh, name)
     seconds["check"] = time.perf_counter() - t0
 
-    t0 = time.perf_counter()
-    smap = spherical_parametrization(mesh, name=name, progress=progress, **(parametrization_options or {}))
-    seconds["parametrize"] = time.perf_counter() - t0
-    for stage, s in smap.timings.items():
-        seconds[f"parametrize/{stage}"] = float(s)
+    if sphere_map is None:
+        t0 = time.perf_counter()
+        smap = spherical_parametrization(mesh, name=name, progress=progress, **(parametrization_options or {}))
+        seconds["parametrize"] = time.perf_counter() - t0
+        for stage, s in smap.timings.items():
+            seconds[f"parametrize/{stage}"] = float(s)
+    else:
+        smap = sphere_map
+        if smap.points.shape != (info["vertices"], 3) or not np.array_equal(smap.points, np.asarray(mesh.points)):
+            raise ValueError(f"sphere_map is not a parametrization of {name}: its points differ from the mesh's.")
 
     t0 = time.perf_counter()
     from .image import image_uv, octahedral_to_sphere

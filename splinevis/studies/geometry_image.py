@@ -203,7 +203,6 @@ def _fairness(s, progress):
     from datasets_synthetic.closed_meshes import star_blob
 
     from ..geometry_image.build import geometry_image_from_mesh
-    from ..geometry_image.fit import fit_geometry_image
     from ..geometry_image.measure import normal_angles
     from ..geometry_image.program import surface_arrays
 
@@ -216,7 +215,6 @@ def _fairness(s, progress):
         ang = normal_angles(N.reshape(-1, 3), exact(P.reshape(-1, 3)))
         rows.append({"fairness": lam, "hausdorff": report.distance["hausdorff"], "rms": report.distance["rms"],
                      "normal_rms_deg": ang["rms"], "normal_max_deg": ang["max"], "fit_rms": report.fit_rms})
-    del fit_geometry_image
     return rows
 
 
@@ -228,7 +226,7 @@ def _lod(s, progress):
 
     from ..geometry_image.build import geometry_image_from_mesh
     from ..geometry_image.program import displacement_map, min_level, surface_arrays
-    from ..geometry_image.subdivision import grid_faces
+    from ..geometry_image.subdivision import grid_faces, linear_subdivide
     from .geometry_image_compare import mesh_rows
 
     mesh = star_blob(level=s["input_level"])
@@ -238,19 +236,17 @@ def _lod(s, progress):
     image, _ = geometry_image_from_mesh(mesh, s["lod_n"], measure=False)
     lo = min_level(image.n)
     levels = np.arange(lo, 3 + 1e-9, 0.125)
-    rows = []
+    rows, prev = [], None
     for lv in progress_bar(levels, "geometry-image: levels", enabled=progress):
         P, N, _ = surface_arrays(image, float(lv), backend="numpy")
         row = {"level": float(lv), **mesh_rows(P.reshape(-1, 3), grid_faces(P.shape[0]), N.reshape(-1, 3), rho, exact,
                                                diag)}
-        if not float(lv).is_integer():  # the geomorph's step from the previous 1/8 (same connectivity)
-            prev = surface_arrays(image, float(lv) - 0.125, backend="numpy")[0] if (lv - 0.125) % 1 else None
-            if prev is None:  # previous is the whole level k: the same points linearly subdivided
-                from ..geometry_image.subdivision import linear_subdivide
-
-                prev = linear_subdivide(surface_arrays(image, float(np.floor(lv)), backend="numpy")[0])
+        if not float(lv).is_integer():  # the geomorph's step from the previous 1/8, on this level's connectivity:
+            if prev.shape != P.shape:  # after a whole level k, its points linearly subdivided
+                prev = linear_subdivide(prev)
             row["motion_max"] = float(np.linalg.norm(P - prev, axis=-1).max()) / diag
         rows.append(row)
+        prev = P
     for row in rows:  # the largest step within [k, k + 1) on the whole level's row
         if float(row["level"]).is_integer():
             steps = [r["motion_max"] for r in rows if "motion_max" in r and np.floor(r["level"]) == row["level"]]

@@ -55,7 +55,7 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 65, stripes: int = 12
 
     with warnings.catch_warnings():  # the folded fraction is in the title
         warnings.simplefilter("ignore")
-        image, report = geometry_image_from_mesh(mesh, n, name="bent blob")
+        image, report = geometry_image_from_mesh(mesh, n, name="bent blob", sphere_map=smap)
     height = np.asarray(mesh.points)[:, 2]
     panels = []
     panels.append(("1. input mesh, %s triangles" % f"{mesh.n_cells:,}",
