@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "star_blob_normals", "stretched_blob", "bent_blob",
-           "torus_mesh", "open_cup", "two_spheres", "nonmanifold_edge"]
+__all__ = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "star_blob_radius", "star_blob_normals", "stretched_blob",
+           "bent_blob", "torus_mesh", "open_cup", "two_spheres", "nonmanifold_edge"]
 
 
 def _poly(points, tri):
@@ -77,8 +77,14 @@ def ellipsoid_mesh(a: float = 2.0, b: float = 1.0, c: float = 0.5, level: int = 
     return _poly(P * [a, b, c], F)
 
 
-def _bump(d, eps):
-    x, y, z = d.T
+def star_blob_radius(d, eps: float = 0.25):
+    """The radius ``rho(d)`` of :func:`star_blob` in the unit directions ``d`` (``(n, 3)``): the exact surface
+    ``rho(d) d`` the tests and studies measure distances to.
+
+    >>> star_blob_radius(np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), eps=0.2).tolist()
+    [1.1, 1.0]
+    """
+    x, y, z = np.asarray(d, dtype=np.float64).T
     return 1.0 + eps * (x * y * z * 5.0 + 0.5 * (x * x - y * y))
 
 
@@ -97,7 +103,7 @@ def star_blob(eps: float = 0.25, level: int = 3):
     True
     """
     P, F = _icosphere(level)
-    return _poly(P * _bump(P, eps)[:, None], F)
+    return _poly(P * star_blob_radius(P, eps)[:, None], F)
 
 
 def star_blob_normals(points, eps: float = 0.25):
@@ -113,7 +119,7 @@ def star_blob_normals(points, eps: float = 0.25):
     d = X / np.linalg.norm(X, axis=1, keepdims=True)
     g = _bump_gradient(d, eps)
     gs = g - np.einsum("ij,ij->i", g, d)[:, None] * d
-    n = d - gs / _bump(d, eps)[:, None]
+    n = d - gs / star_blob_radius(d, eps)[:, None]
     return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
@@ -125,7 +131,7 @@ def stretched_blob(level: int = 3):
     True
     """
     P, F = _icosphere(level)
-    return _poly(P * _bump(P, 0.25)[:, None] * [4.0, 1.0, 1.0], F)
+    return _poly(P * star_blob_radius(P, 0.25)[:, None] * [4.0, 1.0, 1.0], F)
 
 
 def bent_blob(level: int = 3, half_length: float = 2.4, r: float = 0.45):

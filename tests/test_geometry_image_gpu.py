@@ -51,24 +51,11 @@ from splinevis.geometry_image.image import (apply_cut_constraint, cut_neighbours
 from splinevis.geometry_image.subdivision import (average, curvature, cut_normals, displace, geomorph, limit, normals,
                                                   second_derivatives, split, subsample, tangents)
 
+from _subdivision_bounds import C_LIMIT, C_PSS, C_PST, C_TANGENT, U32, U64, control_bounds, gamma
+
 pytestmark = pytest.mark.gl
 
-U32, U64 = 2.0 ** -24, 2.0 ** -53
-C_SPLIT, C_AVERAGE, C_LIMIT, C_TANGENT, C_PSS, C_PST = 3, 15, 10, 7, 10, 3
 LEVELS = 5
-
-
-def gamma(c, u):
-    return c * u / (1.0 - c * u)
-
-
-def control_bounds(levels, M, u, upload):
-    """Componentwise bounds on |computed g^k - exact g^k|, k = 0..levels."""
-    e = [upload * u * M]
-    for _ in range(levels):
-        x = e[-1] + gamma(C_SPLIT, u) * (M + e[-1])
-        e.append(x + gamma(C_AVERAGE, u) * (M + x))
-    return e
 
 
 def cross_error(a, da, b, db, u, c=2):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import NdBSpline
 
-from datasets_synthetic.closed_meshes import star_blob_normals
+from datasets_synthetic.closed_meshes import star_blob_normals, star_blob_radius
 from splinevis.geometry_image.fit import fit_geometry_image, free_variables
 from splinevis.geometry_image.image import (apply_cut_constraint, cut_vertices, image_uv, octahedral_to_sphere, pad,
                                             symmetrize, symmetry_defect)
@@ -14,8 +14,7 @@ from splinevis.geometry_image.model import GeometryImage
 
 
 def _blob(d, eps=0.25):
-    x, y, z = d.T
-    return d * (1.0 + eps * (5.0 * x * y * z + 0.5 * (x * x - y * y)))[:, None]
+    return d * star_blob_radius(d, eps)[:, None]
 
 
 def _random_image(n, seed=0):

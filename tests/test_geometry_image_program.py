@@ -11,28 +11,18 @@ from splinevis.errors import MeshTopologyError
 from splinevis.geometry_image.build import geometry_image_from_mesh
 from splinevis.geometry_image.program import PROGRAM, displacement_map, min_level, surface_arrays
 from splinevis.geometry_image.subdivision import geomorph, subsample
-
-U32 = 2.0 ** -24
-
-
-def _gamma(c):
-    return c * U32 / (1 - c * U32)
-
+from _subdivision_bounds import C_LIMIT, U32, control_bounds, gamma
 
 def position_bound(levels, M, fractional):
     """Float32 bound on |GPU limit point - exact| for an image with max|G - centre| = M (the passes run relative
-    to the centre): the upload rounds once (u M); each level's split (3 roundings on any path) and average (15)
-    pass the error on unamplified and add gamma_c (M + e) (their weights are >= 0 and sum to 1); the limit mask
-    adds gamma_10 (M + e); a geomorph pass (a linear subdivision and a blend, 4 roundings) adds gamma_4 (M + e);
-    adding the centre back in float64 is exact to 2^-53 of the coordinates, counted by the caller. The twin's own
-    float64 error is below 1e-12 M at these levels."""
-    e = U32 * M
-    for _ in range(levels):
-        e += _gamma(3) * (M + e)
-        e += _gamma(15) * (M + e)
-    e += _gamma(10) * (M + e)
+    to the centre): the control points' bound after ``levels`` steps (upload, splits and averages,
+    tests/_subdivision_bounds.py), then the limit mask adds gamma_10 (M + e) and a geomorph pass (a linear
+    subdivision and a blend, 4 roundings) gamma_4 (M + e); adding the centre back in float64 is exact to 2^-53 of
+    the coordinates, counted by the caller. The twin's own float64 error is below 1e-12 M at these levels."""
+    e = control_bounds(levels, M, U32, upload=1)[-1]
+    e += gamma(C_LIMIT, U32) * (M + e)
     if fractional:
-        e += _gamma(4) * (M + e)
+        e += gamma(4, U32) * (M + e)
     return np.sqrt(3.0) * e + 1e-12 * M  # componentwise -> Euclidean
 
 

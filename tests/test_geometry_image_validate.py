@@ -28,13 +28,13 @@ def test_the_sphere_volume_converges_to_4_pi_over_3():
 def test_star_blob_normals_are_the_surface_normals():
     """The exact normals against the gradient of the implicit form G(x) = |x| - rho(x / |x|), by central
     differences (step 1e-5: truncation ~1e-10, rounding ~1e-11), normalized: they agree to 1e-8."""
-    from datasets_synthetic.closed_meshes import _bump
+    from datasets_synthetic.closed_meshes import star_blob_radius
 
     X = star_blob(level=2).points
 
     def G(Y):
         r = np.linalg.norm(Y, axis=1)
-        return r - _bump(Y / r[:, None], 0.25)
+        return r - star_blob_radius(Y / r[:, None], 0.25)
 
     h = 1e-5
     grad = np.column_stack([(G(X + h * e) - G(X - h * e)) / (2 * h) for e in np.eye(3)])

@@ -113,9 +113,9 @@ def subdivision_times(n: int, levels, repeats: int) -> list:
 
 
 def _blob_truth():
-    from datasets_synthetic.closed_meshes import _bump, star_blob_normals
+    from datasets_synthetic.closed_meshes import star_blob_normals, star_blob_radius
 
-    return (lambda d: _bump(d, 0.25)), (lambda X: star_blob_normals(X, 0.25))
+    return (lambda d: star_blob_radius(d, 0.25)), (lambda X: star_blob_normals(X, 0.25))
 
 
 def _accuracy(s, progress):
