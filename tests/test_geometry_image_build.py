@@ -7,25 +7,13 @@ import warnings
 
 import numpy as np
 import pytest
-from scipy.interpolate import NdBSpline
 
+from _cut_vertex import cone_measure
 from datasets_synthetic import closed_meshes as cm
 from splinevis.errors import MeshTopologyError
 from splinevis.geometry_image.build import FOLDED_WARNING, geometry_image_from_mesh
-from splinevis.geometry_image.image import cut_vertices, pad
 
 SHAPES = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "stretched_blob", "bent_blob"]
-
-
-def _cone(G):
-    """Normalized |det[P_ss, P_st, P_tt]| at the cut vertices (scipy's B-spline as the reference)."""
-    N = G.shape[0] - 1
-    knots = np.arange(-3.0, N + 4.0)
-    ref = NdBSpline((knots, knots), pad(G, 1), 3)
-    ts = cut_vertices(G.shape[0]).astype(float)
-    a, b, c = ref(ts, nu=(0, 2)), ref(ts, nu=(1, 1)), ref(ts, nu=(2, 0))
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
-    return np.abs(det) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1) * np.linalg.norm(c, axis=1))
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -35,7 +23,7 @@ def test_every_shape_is_bijective_c1_and_close(shape):
         warnings.simplefilter("always")
         image, report = geometry_image_from_mesh(mesh, 33, name=shape)
     assert report.stretch["flipped"] == 0
-    assert _cone(image.control).max() < 1e-12  # C1 at the cut vertices (see test_geometry_image_model)
+    assert cone_measure(image.control).max() < 1e-12  # C1 at the cut vertices (see test_geometry_image_model)
     # distance to the mesh: the fit's order-2 error at n = 33 plus the mesh's own facets; 0.05 of the diagonal
     # is the bent blob's (the others are within 0.01)
     assert report.distance["hausdorff"] < (0.05 if shape == "bent_blob" else 0.01), report.distance

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 from scipy.interpolate import NdBSpline
 
+from _cut_vertex import cone_measure
 from datasets_synthetic.closed_meshes import star_blob_normals, star_blob_radius
 from splinevis.geometry_image.fit import fit_geometry_image, free_variables
-from splinevis.geometry_image.image import (apply_cut_constraint, cut_vertices, image_uv, octahedral_to_sphere, pad,
-                                            symmetrize, symmetry_defect)
+from splinevis.geometry_image.image import (apply_cut_constraint, image_uv, octahedral_to_sphere, pad, symmetrize,
+                                            symmetry_defect)
 from splinevis.geometry_image.model import GeometryImage
 
 
@@ -74,24 +75,14 @@ def test_c2_at_knot_lines():
         np.testing.assert_allclose(x, y, atol=1e-12 * np.abs(gi.control).max(), rtol=0)
 
 
-def _cone_measure(G):
-    """|det[P_ss, P_st, P_tt]| / (|P_ss| |P_st| |P_tt|) at the four cut vertices: 0 when the second-order terms
-    span a plane (a tangent plane exists, C1), of order 1 for a cusp (three independent directions)."""
-    ref = _reference(G)
-    ts = cut_vertices(G.shape[0]).astype(float)  # (row, column) = (t, s)
-    a, b, c = ref(ts, nu=(0, 2)), ref(ts, nu=(1, 1)), ref(ts, nu=(2, 0))
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
-    return np.abs(det) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1) * np.linalg.norm(c, axis=1))
-
-
 def test_cut_vertices_are_c1_only_with_the_centroid_constraint():
     """[Losasso2003, appendix]: without the constraint the subdominant eigenvalue 1/4 is triple and the three
     second-order terms are independent (a cusp); with it they are coplanar. Rounding bound for the constrained
     case: each term is a sum of ~16 products of values <= |G|, so the normalized determinant is ~1e-14."""
     G = symmetrize(octahedral_to_sphere(image_uv(17)) * [2.0, 1.0, 0.7]
                    + 0.05 * np.random.default_rng(3).normal(size=(17, 17, 3)))
-    free = _cone_measure(G)
-    constrained = _cone_measure(apply_cut_constraint(G))
+    free = cone_measure(G)
+    constrained = cone_measure(apply_cut_constraint(G))
     assert free.min() > 1e-3, free
     assert constrained.max() < 1e-12, constrained
 

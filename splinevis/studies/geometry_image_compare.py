@@ -22,6 +22,8 @@ import os
 
 import numpy as np
 
+from ..geometry_image.measure import normal_angles
+
 __all__ = ["loop_meshlab", "catmull_clark_meshlab", "loop_vtk", "vertex_normals", "radial_error", "mesh_rows"]
 
 
@@ -143,9 +145,6 @@ def mesh_rows(V, F, N, rho, exact_normals, diagonal) -> dict:
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     d = radial_error(_drawn_points(V, F), rho) / float(diagonal)
-    n = np.asarray(N, dtype=np.float64)
-    n = n / np.linalg.norm(n, axis=1, keepdims=True)
-    ex = np.asarray(exact_normals(V), dtype=np.float64)
-    angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", n, ex), -1.0, 1.0)))
+    angle = normal_angles(N, exact_normals(V))
     return {"triangles": int(len(F)), "distance_max": float(d.max()), "distance_rms": float(np.sqrt((d ** 2).mean())),
-            "normal_max_deg": float(angle.max()), "normal_rms_deg": float(np.sqrt((angle ** 2).mean()))}
+            "normal_max_deg": angle["max"], "normal_rms_deg": angle["rms"]}
