@@ -31,7 +31,7 @@ from .spec import ProgramSpec
 
 from vtkmodules.vtkCommonCore import VTK_OBJECT
 
-__all__ = ["ProgramSpec", "SplineActor", "make_actor", "capture_vtk_errors"]
+__all__ = ["ProgramSpec", "SplineActor", "make_actor", "camera_frame", "capture_vtk_errors"]
 
 _VS_DEC = """//VTK::Normal::Dec
 out vec3 svPosMC;
@@ -198,6 +198,38 @@ def raise_for_shader_errors(text: str, assembled: Assembled | None = None) -> No
     stage = "fragment" if "fragOutput0" in source else ("vertex" if "gl_Position" in source else "unknown")
     origin = assembled.origin_in(source) if assembled is not None and source else None
     raise ShaderCompileError("\n".join(log_lines), source, stage, origin)
+
+
+def camera_frame(renderer, offset, position=None, rotation=None):
+    """(eye, view direction, parallel flag, world-from-camera rotation) of ``renderer``'s camera in a model frame:
+    world shifted by ``offset`` or, for a rotated model (``rotation`` R, placed at ``position``),
+    ``R^T (world - position)``; in double precision (what a spline actor and a mesh drawn relative to its centre
+    hand their shaders).
+
+    Examples
+    --------
+    >>> from vtkmodules.vtkRenderingCore import vtkRenderer
+    >>> renderer = vtkRenderer()
+    >>> camera = renderer.GetActiveCamera()
+    >>> camera.SetPosition(100, 0, 5); camera.SetFocalPoint(100, 0, 0); camera.SetViewUp(0, 1, 0)
+    >>> eye, view, parallel, rotation = camera_frame(renderer, np.array([100.0, 0.0, 0.0]))
+    >>> eye, view, parallel
+    (array([0., 0., 5.]), array([ 0.,  0., -1.]), False)
+    """
+    offset = np.asarray(offset, dtype=np.float64)
+    cam = renderer.GetActiveCamera()
+    eye = np.array(cam.GetPosition(), dtype=np.float64) - offset  # model frame (double precision)
+    focal = np.array(cam.GetFocalPoint(), dtype=np.float64) - offset
+    view = focal - eye
+    view /= np.linalg.norm(view)
+    m = cam.GetViewTransformMatrix()
+    rot = np.array([[m.GetElement(i, j) for j in range(3)] for i in range(3)])  # camera-from-world
+    if rotation is not None:  # a rotated model: camera and its frame into the model frame
+        R = rotation
+        eye = R.T @ (np.array(cam.GetPosition(), dtype=np.float64) - position)
+        view = R.T @ view
+        return eye, view / np.linalg.norm(view), bool(cam.GetParallelProjection()), R.T @ rot.T
+    return eye, view, bool(cam.GetParallelProjection()), rot.T
 
 
 class SplineActor:
@@ -469,19 +501,7 @@ class SplineActor:
                [0., 1., 0.],
                [0., 0., 1.]])
         """
-        cam = self.renderer.GetActiveCamera()
-        eye = np.array(cam.GetPosition(), dtype=np.float64) - self.offset  # model frame (double precision)
-        focal = np.array(cam.GetFocalPoint(), dtype=np.float64) - self.offset
-        view = focal - eye
-        view /= np.linalg.norm(view)
-        m = cam.GetViewTransformMatrix()
-        rot = np.array([[m.GetElement(i, j) for j in range(3)] for i in range(3)])  # camera-from-world
-        if self.rotation is not None:  # a rotated model: camera and its frame into the model frame
-            R = self.rotation
-            eye = R.T @ (np.array(cam.GetPosition(), dtype=np.float64) - self.position)
-            view = R.T @ view
-            return eye, view / np.linalg.norm(view), bool(cam.GetParallelProjection()), R.T @ rot.T
-        return eye, view, bool(cam.GetParallelProjection()), rot.T
+        return camera_frame(self.renderer, self.offset, self.position, self.rotation)
 
     def _texture_map(self):
         """(scale_u, scale_v, shift_u, shift_v) from the model's parameter domain to the image."""

@@ -20,14 +20,13 @@ effects' GLSL is compiled in.
 
 from __future__ import annotations
 
-from types import SimpleNamespace
 
 import numpy as np
 from vtkmodules.vtkCommonCore import VTK_OBJECT
 
 from ..effects import EFFECTS, Style
 from .assembler import assemble
-from .inject import SplineActor, _set_uniform
+from .inject import _set_uniform, camera_frame
 
 __all__ = ["add_mesh_with_reflection_lines", "add_mesh_with_effects", "MESH_EFFECTS", "CURVATURE_ARRAY"]
 
@@ -170,7 +169,6 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
         add = sp.AddVertexShaderReplacement if stage == "vertex" else sp.AddFragmentShaderReplacement
         add(tag, True, text, False)
     renderer = plotter.renderer
-    frame = SimpleNamespace(renderer=renderer, offset=centre, position=centre, rotation=None)
     style_uniforms = style.uniforms()
     actor.program_sources = {}
 
@@ -181,7 +179,7 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
             actor.program_sources = {"vertex": program.GetVertexShader().GetSource(),
                                      "fragment": program.GetFragmentShader().GetSource()}
         # the model frame: world shifted by the mesh's centre, as a spline actor with that offset and no rotation
-        eye, view, parallel, world_from_cam = SplineActor.camera_frame(frame)
+        eye, view, parallel, world_from_cam = camera_frame(renderer, centre)
         uniforms = {"sv_eye_mc": eye, "sv_view_dir_mc": view, "sv_parallel": int(parallel)}
         if "isophotes" in effects:
             uniforms["sv_light_dir[]"] = style.light_directions_camera()[:1] @ world_from_cam.T
