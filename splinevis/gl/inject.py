@@ -283,7 +283,9 @@ class SplineActor:
         self.kind = kind
         # a ray-cast proxy is drawn from its far side (the camera may be inside it); a surface mesh is the
         # surface itself: both sides drawn
-        if cull_front if cull_front is not None else kind == "raycast":
+        if cull_front is None:
+            cull_front = spec.cull_front if spec.cull_front is not None else kind == "raycast"
+        if cull_front:
             prop.FrontfaceCullingOn()
         if style.opacity < 1:
             prop.SetOpacity(float(style.opacity))

@@ -40,6 +40,9 @@ class ProgramSpec:
         cube to float32 precision whatever the volume's size.
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    cull_front : bool or None
+        Whether the actor culls front faces (None: the kind's default, culled for ray-cast proxies drawn from
+        their far side). The terrain's mesh proxy (``proxy="mesh"``) draws both sides (False).
     world_frame : (rotation (3, 3), pivot (3,)) or None
         For a model drawn in a rotated frame (a volume on a rotated orthogonal lattice): the actor maps model
         coordinates into the world by this rotation about ``pivot`` (:meth:`SplineActor.set_frame`).
@@ -73,3 +76,4 @@ class ProgramSpec:
     offset: tuple = (0.0, 0.0, 0.0)
     glsl_roots: tuple = ()
     world_frame: tuple | None = None
+    cull_front: bool | None = None
