@@ -203,8 +203,8 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
                             frame_uniforms=lambda eye, view: {"sv_mesh_eye_inside": int(mesh.eye_inside(eye))},
                             glsl_roots=(src,) if (src / "lib" / "terrain" / "mesh_guided.glsl").is_file() else ())
         extra_defines = {**extra_defines, "SV_TERRAIN_MESH": True}
-        extra_uniforms = {**extra_uniforms, "sv_mesh_cells": check_degree(mesh_cells, "mesh_cells", low=0, high=64),
-                          "sv_mesh_eye_inside": 0}
+        # (sv_mesh_eye_inside is only a frame uniform: a spec uniform of that name would override it)
+        extra_uniforms = {**extra_uniforms, "sv_mesh_cells": check_degree(mesh_cells, "mesh_cells", low=0, high=64)}
     return ProgramSpec(
         name="terrain",
         entry="programs/terrain.glsl",

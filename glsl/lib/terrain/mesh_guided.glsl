@@ -62,19 +62,25 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
                                          : clamp(ivec2(floor(P0.xy)), ivec2(0), last);
     ivec2 stepdir = ivec2(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1);
     float t = 0.0;
+    // where the ray leaves the terrain's box (as the full walk clips it): no hit beyond, and a finite end for
+    // a vertical ray, whose cell segment is otherwise unbounded (its rounding estimates then are too)
+    float t_end = 3.0e38;
+    vec3 blo = vec3(0.0, 0.0, sv_zrange.x);
+    vec3 bhi = vec3(sv_ncells, sv_zrange.y);
+    for (int k = 0; k < 3; ++k) {
+        if (abs(D[k]) >= 1e-30) t_end = min(t_end, max((blo[k] - P0[k]) / D[k], (bhi[k] - P0[k]) / D[k]));
+    }
     for (int s = 0; s < sv_mesh_cells; ++s) {
         vec2 lo = vec2(c);
         vec2 hi = lo + vec2(1.0);
         float tx = abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? hi.x : lo.x) - P0.x) / D.x;
         float ty = abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? hi.y : lo.y) - P0.y) / D.y;
-        float tb = min(tx, ty);
+        float tb = min(min(tx, ty), t_end);
         vec2 mm = sv_block_minmax(0, c);
-        float tz = min(tb, 1.0e30);
         float za = P0.z + t * D.z;
-        float zb = P0.z + tz * D.z;
-        float zerr = 2.384185791015625e-07 * (abs(P0.z) + max(abs(t), abs(tz)) * abs(D.z));
-        bool vertical = tb > 1.0e30;
-        if (vertical || (max(za, zb) + zerr >= mm.x && min(za, zb) - zerr <= mm.y)) {
+        float zb = P0.z + tb * D.z;
+        float zerr = 2.384185791015625e-07 * (abs(P0.z) + max(abs(t), abs(tb)) * abs(D.z));
+        if (max(za, zb) + zerr >= mm.x && min(za, zb) - zerr <= mm.y) {
             float b0[15];
             float b1[15];
             sv_load_cell(c, b0, b1);
@@ -99,7 +105,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
                 return true;
             }
         }
-        if (vertical) return false;  // the ray stays in this cell's column
+        if (tb >= t_end) return false;  // the ray leaves the terrain's box (a vertical ray: its cell's column)
         if (tx <= ty) c.x += stepdir.x; else c.y += stepdir.y;
         t = tb;
         // R lies over the domain (a rectangle): a ray leaving it does not come back
