@@ -24,8 +24,9 @@ What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_
   with A, B, C the largest magnitudes of those coefficients over the cell's two triangles, and by
   Gershgorin M <= max(A, C) + B. The cell's lift is M h^2 / 4 plus a float32 margin (1e-5 of the height
   span plus 1e-5 of the largest coordinate: the VBO holds float32 positions and the rasterizer
-  interpolates them). The bound is per cell, hence valid for every scheme (no continuity across cell edges
-  is used).
+  interpolates them; the horizontal part of that error moves the point vertically by up to the slope times it,
+  so the coordinate term is multiplied by 1 + |f_x| + |f_y|, bounded from the first differences). The bound
+  is per cell, hence valid for every scheme (no continuity across cell edges is used).
 * **The fragment.** The actor draws both sides (no culling). With the eye outside R (decided per frame on
   the CPU, conservatively: :meth:`LiftedMesh.eye_inside`), front faces run the guided search and back faces
   are discarded: every ray that meets the surface enters R through a front face before it, at or after the
@@ -59,7 +60,7 @@ import numpy as np
 
 from ..bb import simplex as _simplex
 
-__all__ = ["second_derivative_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
+__all__ = ["second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
 
 #: Largest grid (cells) the mesh proxy builds a mesh for.
 MAX_MESH_CELLS = 512 * 512
@@ -102,7 +103,8 @@ def cell_lifts(terrain, k: int) -> np.ndarray:
     >>> from splinevis.terrain.model import TerrainSpline
     >>> y, x = np.mgrid[0:6, 0:6].astype(float)
     >>> t = TerrainSpline.from_heights(x * x, "C1")
-    >>> bool(np.allclose(cell_lifts(t, 2), 2.0 / 16, rtol=1e-2))  # 2 (1/2)^2 / 4 and the float32 margin
+    >>> lifts = cell_lifts(t, 2)  # the chord bound 2 (1/2)^2 / 4 = 0.125 and the float32 margin
+    >>> bool((lifts >= 0.125).all() and (lifts < 0.13).all())
     True
     """
     c = terrain.coefficients
@@ -111,7 +113,27 @@ def cell_lifts(terrain, k: int) -> np.ndarray:
     x0, x1, y0, y1 = terrain.extent
     span = float(c.max() - c.min())
     coord = max(0.5 * (x1 - x0), 0.5 * (y1 - y0), float(np.abs(c).max()))
-    return lift + 1e-5 * span + 1e-5 * coord
+    # the fragment's point (float32, interpolated) may sit off the mesh by ~1e-5 coord in any direction: on a
+    # slope of gradient g that moves it vertically by g times as much (the linear scheme's cliff leaked without)
+    sx, sy = terrain.cell_spacing
+    return lift + 1e-5 * span + 1e-5 * coord * (1.0 + gradient_bounds(c, sx, sy))
+
+
+def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarray:
+    """(ncy, ncx) bound of |f_x| + |f_y| (model units; cell size sx x sy) over each cell: the largest
+    |BB coefficient| of f_u and f_v (4 first differences) over T0 and T1, divided by the cell size.
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:4, 0:4].astype(float)
+    >>> bool(np.allclose(gradient_bounds(TerrainSpline.from_heights(3 * x - y, "C1").coefficients), 4.0))
+    True
+    """
+    c = np.asarray(coefficients, dtype=np.float64)
+    out = 0.0
+    for dirs, size in ((_DU, sx), (_DV, sy)):
+        out = out + np.maximum(*(np.abs(_simplex.derivative(c[..., tri, :], dirs[tri], d=2)).max(axis=-1)
+                                 for tri in (0, 1))) / size
+    return out
 
 
 @dataclass
