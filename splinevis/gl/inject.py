@@ -312,6 +312,16 @@ class SplineActor:
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
         mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
+        if spec.cull_per_frame is not None and renderer is not None:
+            renderer.AddObserver(vtkCommand.StartEvent, self._on_render_start)
+
+    def _on_render_start(self, caller=None, event=None):
+        """Per-frame face culling of specs that ask for it (``ProgramSpec.cull_per_frame``)."""
+        eye, view, parallel, _ = self.camera_frame()
+        which = self.spec.cull_per_frame(eye, view, parallel)
+        prop = self.actor.GetProperty()
+        prop.SetFrontfaceCulling(which == "front")
+        prop.SetBackfaceCulling(which == "back")
 
     @staticmethod
     def _per_vertex(spec):

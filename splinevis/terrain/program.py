@@ -201,6 +201,10 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         src = Path(__file__).resolve().parents[2] / "glsl"
         mesh_options = dict(attributes={"sv_mesh_cell": mesh.cells}, cull_front=False,
                             frame_uniforms=lambda eye, view: {"sv_mesh_eye_inside": int(mesh.eye_inside(eye))},
+                            # the fragments of the faces the shader discards are not drawn at all (llvmpipe: the
+                            # discarded back faces cost a third of the frame); the shader's test stays the rule
+                            cull_per_frame=lambda eye, view, parallel: (
+                                "front" if (not parallel and mesh.eye_inside(eye)) else "back"),
                             glsl_roots=(src,) if (src / "lib" / "terrain" / "mesh_guided.glsl").is_file() else ())
         extra_defines = {**extra_defines, "SV_TERRAIN_MESH": True}
         # (sv_mesh_eye_inside is only a frame uniform: a spec uniform of that name would override it)
