@@ -183,7 +183,7 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     >>> t = TerrainSpline.from_heights(np.sin(x) + y, "C1")
     >>> m = lifted_mesh(t, 2)
     >>> m.points.shape, m.triangles.shape   # 12 cells x 9 vertices + walls + bottom
-    ((168, 3), (154, 3))
+    ((165, 3), (180, 3))
     >>> u = np.random.default_rng(0).uniform(0, 1, (2000, 2))  # the mesh lies above the surface
     >>> bool(mesh_above(t, m, u[:, 0] * 4, u[:, 1] * 3).min() > 0)
     True
@@ -265,15 +265,14 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     b_ = n0 + nr + idx
     # outward: for a counter-clockwise ring seen from above, (bottom_i, bottom_next, top_next), (bottom_i, top_next, top_i)
     tris_wall = np.concatenate([np.stack([b_, n0 + nr + nxt, n0 + nxt], 1), np.stack([b_, n0 + nxt, t_], 1)])
-    # bottom: the four corners of the box's bottom, facing down (no vertex of the domain's border lies inside
-    # its edges' span, and the walls' bottom edges are collinear with them: watertight up to rounding)
+    # bottom: a fan from the centre over the walls' bottom vertices, facing down (the domain is convex); it shares
+    # the walls' bottom edges, so the closed mesh has no T-junction (four corner triangles left a crack)
     nc = n0 + 2 * nr
-    corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]) - off[:2]
-    bottom = np.column_stack([corners, np.full(4, zb)])
-    tris_bottom = np.array([[nc, nc + 2, nc + 1], [nc, nc + 3, nc + 2]])
+    bottom = np.array([[0.5 * (x0 + x1) - off[0], 0.5 * (y0 + y1) - off[1], zb]])
+    tris_bottom = np.stack([np.full(nr, nc), n0 + nr + nxt, n0 + nr + idx], 1)
     points = np.concatenate([pts_top, wall_top, wall_bot, bottom])
     # walls and bottom carry cell -1: their fragments locate their cell from their position (clamped)
-    cells = np.concatenate([cell_top, np.full((2 * nr + 4, 2), -1.0)])
+    cells = np.concatenate([cell_top, np.full((2 * nr + 1, 2), -1.0)])
     triangles = np.concatenate([tris_top, tris_wall, tris_bottom]).astype(np.int64)
     return LiftedMesh(points, triangles, cells, top, zb, (x0 - off[0], x1 - off[0], y0 - off[1], y1 - off[1]), k)
 
