@@ -8,9 +8,10 @@ What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_
   (T0 or T1) of one cell. Vertex heights are ``s(vertex) + lift(vertex)``, where ``lift(vertex)`` is the
   largest cell lift (below) over the cells that touch the vertex: shared vertices get one height (the mesh
   is watertight when rasterized) and every sub-triangle of cell c is lifted by at least that cell's lift.
-  Side walls go down from the border vertices to the bottom of the terrain's box, and a bottom face closes
-  the region R = {(x, y) in the domain, z_bottom <= z <= mesh(x, y)}, outward oriented. Every vertex carries
-  its cell (i, j) (flat attribute ``sv_mesh_cell``; -1 on the bottom face, whose fragments locate their cell).
+  Side walls go down from the border vertices to below the terrain's box, and a bottom face (a fan over the
+  walls' bottom vertices: no T-junction) closes the region R = {(x, y) in the domain, z_bottom <= z <=
+  mesh(x, y)}, outward oriented. Every vertex carries its cell (i, j) (flat attribute ``sv_mesh_cell``; -1 on
+  the walls and the bottom, whose fragments locate their cell from their position).
 * **The lift is a proof, not a guess.** On a sub-triangle T with vertices v_i and linear interpolant L of a
   C2 function f, for x in T with x = sum lam_i v_i, Taylor's theorem at x gives
   f(v_i) = f(x) + grad f(x).(v_i - x) + 1/2 (v_i - x)^T H(xi_i) (v_i - x); summing with weights lam_i
@@ -27,29 +28,47 @@ What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_
   interpolates them; the horizontal part of that error moves the point vertically by up to the slope times it,
   so the coordinate term is multiplied by 1 + |f_x| + |f_y|, bounded from the first differences). The bound
   is per cell, hence valid for every scheme (no continuity across cell edges is used).
-* **The fragment.** The actor draws both sides (no culling). With the eye outside R (decided per frame on
-  the CPU, conservatively: :meth:`LiftedMesh.eye_inside`), front faces run the guided search and back faces
-  are discarded: every ray that meets the surface enters R through a front face before it, at or after the
+* **The fragment.** With the eye outside R (decided per frame on the CPU, conservatively:
+  :meth:`LiftedMesh.eye_inside`), back faces are culled (``ProgramSpec.cull_per_frame``; the shader discards
+  them too) and front faces run the guided search: every ray that meets the surface enters R through a front face before it, at or after the
   fragment's own point (t = 0 of the ray, which starts at the fragment). The search walks the cells along the
   ray from the fragment's cell, ``mesh_cells`` cells at most, each bracketed by its prism (level-0 min/max) and
   tested exactly as in the box program (restriction by blossoming, first root, both triangles); the first
   hit found is the hit (cells are visited front to back). Leaving the domain is a miss (R lies over the
   domain, a convex rectangle). When the cells run out, the full hierarchy walk (``sv_surface_hit`` of the box
-  program) continues from there. With the eye inside R (or close to it), front faces are discarded and
-  back faces run the full ray cast from the eye (what the box proxy does). Normals, curvature, effects and
+  program) continues from there. With the eye inside R (or close to it), front faces are culled and
+  back faces run the full ray cast from the eye (what the box proxy does: every ray leaves R through one). Normals, curvature, effects and
   gl_FragDepth are computed as in the box program.
 
-What works (measured on the hard cases, see the tests and the branch's commit messages) and what does not:
+What works, measured (llvmpipe):
 
-* Grids up to :data:`MAX_MESH_CELLS` cells only (the mesh has ``2 k^2 + ...`` triangles per cell and is built
-  in numpy on every ``terrain_program`` call): larger grids raise ``ValueError``; a coarser mesh over blocks
-  of cells (each lifted to the block's max, or a LOD chosen from screen-space size) is not built.
-* ``k`` is fixed per program (``mesh_samples``), not chosen from the screen-space size of a cell.
+* Agreement with the float64 twin: all 43 terrain hard cases but the 2048^2 fractal (too large, below) pass
+  :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does (same one-sided
+  pixel counts, no leak, the same fraction of depths within the bound), at ``mesh_samples`` 2 with
+  ``mesh_cells`` 4 and at 1 with 1 (the fallback taken more often). tests/test_terrain_mesh_proxy.py checks 8
+  of them, and that the mesh lies above the spline on 40,000 random points of a crater in 4 schemes.
+* Speed: on the profile benchmark's full-screen C1 frame (benchmarks/bench_profile.py's scene, 800 x 600) the
+  mesh proxy is not faster than the box (see the branch's last commit message for the numbers): the walk it
+  saves was 5 % of the frame; the restriction and the root finder (73 %) run as often as before, on about
+  1.3 front-facing fragments per pixel instead of 1. Culling the back faces (rather than discarding them in
+  the shader) mattered: discarded fragments cost a third of the frame.
+
+What does not, or is not built:
+
+* Grids over :data:`MAX_MESH_CELLS` cells raise ``ValueError`` (the mesh has 2 k^2 triangles per cell and is
+  built in numpy at every ``terrain_program`` call): a coarser mesh over blocks of cells (each lifted to the
+  block's maximum, from the min/max pyramid) or a level of detail chosen from screen-space size is not built;
+  ``k`` is fixed per program.
+* The guidance does not yet shorten the root search: the first cell's segment starts at the fragment, but the
+  restricted quartic is still searched over the whole rest of the cell. Bracketing the root between the
+  fragment and the ray's exit from the mesh's lower envelope (a second mesh lowered by the same bound, where
+  the ray is known to be under the surface) would give the root finder one sign change on a short interval.
 * The near clipping plane: a front face of R in front of the near plane is clipped, and a pixel whose surface
-  hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the
-  near distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
-* Overdraw: every front face along a ray runs the search (the depth test keeps the nearest); a ray that
-  re-enters R behind a hill pays again.
+  hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the near
+  distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
+* Overdraw: every front face along a ray runs the search (gl_FragDepth is written, so there is no early depth
+  test); a depth pre-pass of the mesh with conservative depth (``depth_greater``) could reject the later ones.
+* No debug builds (``debug`` is refused with ``proxy="mesh"``); no frustum culling of the mesh.
 """
 
 from __future__ import annotations
