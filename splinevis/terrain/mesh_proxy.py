@@ -47,11 +47,14 @@ What works, measured (llvmpipe):
   pixel counts, no leak, the same fraction of depths within the bound), at ``mesh_samples`` 2 with
   ``mesh_cells`` 4 and at 1 with 1 (the fallback taken more often). tests/test_terrain_mesh_proxy.py checks 8
   of them, and that the mesh lies above the spline on 40,000 random points of a crater in 4 schemes.
-* Speed: on the profile benchmark's full-screen C1 frame (benchmarks/bench_profile.py's scene, 800 x 600) the
-  mesh proxy is not faster than the box (see the branch's last commit message for the numbers): the walk it
-  saves was 5 % of the frame; the restriction and the root finder (73 %) run as often as before, on about
-  1.3 front-facing fragments per pixel instead of 1. Culling the back faces (rather than discarding them in
-  the shader) mattered: discarded fragments cost a third of the frame.
+* Speed: on the profile benchmark's full-screen C1 frame (benchmarks/bench_profile.py's scene, 800 x 600,
+  65 x 65 samples) the mesh proxy is slower than the box, and more so the finer the mesh (about 1.15x at
+  k = 1, 1.4x at k = 2, 2x at k = 4 on a shared machine; numbers in the commit that added this paragraph).
+  The walk it saves was 5 % of the frame; the restriction and the root finder (73 %) run as often as before,
+  on about 1.3 front-facing fragments per pixel instead of 1. That the cost grows with k suggests (not
+  measured) that llvmpipe shades partly covered pixel blocks along every triangle's edges in full, so small
+  triangles multiply this heavy shader's invocations. Culling the back faces per frame (rather than
+  discarding them in the shader) mattered: the discarded fragments had cost a third of the frame.
 
 What does not, or is not built:
 
