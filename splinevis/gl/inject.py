@@ -312,7 +312,7 @@ class SplineActor:
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
         mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
-        if spec.cull_per_frame is not None and renderer is not None:
+        if spec.cull_per_frame is not None and renderer is not None:  # before each frame: see ProgramSpec
             renderer.AddObserver(vtkCommand.StartEvent, self._on_render_start)
 
     def _on_render_start(self, caller=None, event=None):

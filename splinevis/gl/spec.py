@@ -42,7 +42,7 @@ class ProgramSpec:
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
     cull_front : bool or None
         Whether the actor culls front faces (None: the kind's default, culled for ray-cast proxies drawn from
-        their far side). The terrain's mesh proxy (``proxy="mesh"``) draws both sides (False).
+        their far side; False: neither). ``cull_per_frame``, when given, decides instead, every frame.
     cull_per_frame : callable, optional
         ``f(eye_mc, view_dir_mc, parallel) -> "front" | "back" | None``, called before every render of the
         actor's renderer: which faces to cull in this frame (None: none). The terrain's mesh proxy culls back

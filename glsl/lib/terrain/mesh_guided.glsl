@@ -3,8 +3,8 @@
 // hierarchy walk, which is then named sv_surface_hit_full.
 //
 // The proxy is a lifted tessellation of the spline (above the surface everywhere, by a proven bound) closed by
-// side walls and a bottom, drawn without culling. With the eye outside the region under it (uniform
-// sv_mesh_eye_inside = 0, decided per frame on the CPU), a front-facing fragment starts the ray at its own
+// side walls and a bottom; the actor culls per frame the faces this file discards. With the eye outside the
+// region under it (uniform sv_mesh_eye_inside = 0, decided per frame on the CPU), a front-facing fragment starts the ray at its own
 // point (t = 0; ro is the fragment): the surface is not crossed before it. The cells along the ray are tested
 // from the fragment's cell (the flat vertex attribute sv_mesh_cell; walls and bottom carry -1 and locate it),
 // sv_mesh_cells cells at most, each bracketed by its prism (level-0 min/max) and tested exactly as the full
