@@ -12,6 +12,11 @@
 #include "lib/core/table.glsl"
 #include "lib/simplex/bb_triangle.glsl"
 #include "lib/simplex/graph_patch.glsl"
+#ifdef SV_TERRAIN_MESH
+// the mesh-guided build (proxy="mesh"): the full walk below becomes sv_surface_hit_full, the fallback of
+// lib/terrain/mesh_guided.glsl (included at the end), which defines sv_surface_hit
+#define sv_surface_hit sv_surface_hit_full
+#endif
 
 // VTK declares the samplers of the textures set on the actor, both tables (lib/core/table.glsl):
 // sv_terrain_coef (8 texels per cell, cells row after row: T0's 15 then T1's 15 coefficients, 2 zeros) and
@@ -280,4 +285,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
 #endif
     return true;
 }
+#endif
+#ifdef SV_TERRAIN_MESH
+#undef sv_surface_hit
+#include "lib/terrain/mesh_guided.glsl"
 #endif

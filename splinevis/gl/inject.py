@@ -315,7 +315,9 @@ class SplineActor:
         self.kind = kind
         # a ray-cast proxy is drawn from its far side (the camera may be inside it); a surface mesh is the
         # surface itself: both sides drawn
-        if cull_front if cull_front is not None else kind == "raycast":
+        if cull_front is None:
+            cull_front = spec.cull_front if spec.cull_front is not None else kind == "raycast"
+        if cull_front:
             prop.FrontfaceCullingOn()
         if style.opacity < 1:
             prop.SetOpacity(float(style.opacity))
@@ -342,6 +344,16 @@ class SplineActor:
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
         mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
+        if spec.cull_per_frame is not None and renderer is not None:  # before each frame: see ProgramSpec
+            renderer.AddObserver(vtkCommand.StartEvent, self._on_render_start)
+
+    def _on_render_start(self, caller=None, event=None):
+        """Per-frame face culling of specs that ask for it (``ProgramSpec.cull_per_frame``)."""
+        eye, view, parallel, _ = self.camera_frame()
+        which = self.spec.cull_per_frame(eye, view, parallel)
+        prop = self.actor.GetProperty()
+        prop.SetFrontfaceCulling(which == "front")
+        prop.SetBackfaceCulling(which == "back")
 
     @staticmethod
     def _per_vertex(spec):

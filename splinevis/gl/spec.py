@@ -40,6 +40,13 @@ class ProgramSpec:
         cube to float32 precision whatever the volume's size.
     frame_uniforms : callable, optional
         ``f(eye_mc, view_dir_mc) -> dict`` of uniforms recomputed every frame.
+    cull_front : bool or None
+        Whether the actor culls front faces (None: the kind's default, culled for ray-cast proxies drawn from
+        their far side; False: neither). ``cull_per_frame``, when given, decides instead, every frame.
+    cull_per_frame : callable, optional
+        ``f(eye_mc, view_dir_mc, parallel) -> "front" | "back" | None``, called before every render of the
+        actor's renderer: which faces to cull in this frame (None: none). The terrain's mesh proxy culls back
+        faces while the eye is outside the region under its mesh and front faces while it may be inside.
     world_frame : (rotation (3, 3), pivot (3,)) or None
         For a model drawn in a rotated frame (a volume on a rotated orthogonal lattice): the actor maps model
         coordinates into the world by this rotation about ``pivot`` (:meth:`SplineActor.set_frame`).
@@ -73,3 +80,5 @@ class ProgramSpec:
     offset: tuple = (0.0, 0.0, 0.0)
     glsl_roots: tuple = ()
     world_frame: tuple | None = None
+    cull_front: bool | None = None
+    cull_per_frame: Callable | None = None

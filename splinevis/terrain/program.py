@@ -24,6 +24,8 @@ __all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_gri
            "debug_defines", "DEBUG_MODES", "PROGRAM"]
 
 ROOTS = ("bracketed", "paper")
+#: Proxies of the program (option ``proxy``): the bounding box, or the lifted mesh (splinevis.terrain.mesh_proxy).
+PROXIES = ("box", "mesh")
 #: Debug builds of the program (option ``debug``; none is compiled unless asked for, see :func:`debug_defines`).
 DEBUG_MODES = ("counters", "flat", "restrict", "traversal", "raymarch")
 #: Levels the shader's hierarchy uniforms hold.
@@ -125,7 +127,8 @@ def debug_defines(debug: str | None) -> tuple:
 
 def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: int = 8, max_steps: int | None = None,
                     hierarchy: bool | int = True, roots: str = "bracketed",
-                    rows_per_texture: int = ROWS_PER_TEXTURE, debug: str | None = None) -> ProgramSpec:
+                    rows_per_texture: int = ROWS_PER_TEXTURE, debug: str | None = None, proxy: str = "box",
+                    mesh_samples: int = 2, mesh_cells: int = 4) -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
     ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
@@ -135,6 +138,10 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     ``rows_per_texture``: rows of one texture of the coefficient table (default: 1 GiB textures; smaller
     values split small tables too, which the tests use to check the split path). ``debug``: None (default)
     or a debug build for profiling (:func:`debug_defines`). ``style`` decides nothing.
+    ``proxy``: ``"box"`` (default: one box around the terrain, drawn from its far side) or ``"mesh"`` (a
+    prototype: the lifted tessellation of :mod:`splinevis.terrain.mesh_proxy` with ``mesh_samples`` x
+    ``mesh_samples`` sub-squares per cell; each fragment searches ``mesh_cells`` cells along its ray from its
+    own point, then falls back to the full walk).
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
@@ -150,6 +157,10 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     """
     if not isinstance(terrain, TerrainSpline):
         raise TypeError(f"terrain must be a TerrainSpline, got {type(terrain).__name__}.")
+    if proxy not in PROXIES:
+        raise ValueError(f"proxy must be one of {', '.join(map(repr, PROXIES))}; got {proxy!r}.")
+    if proxy == "mesh" and debug is not None:
+        raise ValueError("proxy='mesh' has no debug builds.")
     iterations = check_degree(newton_iterations, "newton_iterations", low=1, high=8)
     extra_defines, extra_uniforms = debug_defines(debug)
     check_root_method(roots, ROOTS, degree=4)
@@ -177,6 +188,27 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     level_offsets, level_widths = np.zeros(MAX_LEVELS, np.int64), np.zeros(MAX_LEVELS, np.int64)
     level_offsets[: len(offsets)] = offsets
     level_widths[: len(widths)] = widths
+    mesh_options = {}
+    if proxy == "mesh":
+        from pathlib import Path
+
+        from .mesh_proxy import lifted_mesh
+
+        mesh = lifted_mesh(terrain, check_degree(mesh_samples, "mesh_samples", low=1, high=16))
+        points, triangles = mesh.points, mesh.triangles
+        # the repository's glsl/ first when the package runs from a source tree (a worktree whose editable
+        # install points elsewhere); in an installed package the folder does not exist and is skipped
+        src = Path(__file__).resolve().parents[2] / "glsl"
+        mesh_options = dict(attributes={"sv_mesh_cell": mesh.cells}, cull_front=False,
+                            frame_uniforms=lambda eye, view: {"sv_mesh_eye_inside": int(mesh.eye_inside(eye))},
+                            # the fragments of the faces the shader discards are not drawn at all (llvmpipe: the
+                            # discarded back faces cost a third of the frame); the shader's test stays the rule
+                            cull_per_frame=lambda eye, view, parallel: (
+                                "front" if (not parallel and mesh.eye_inside(eye)) else "back"),
+                            glsl_roots=(src,) if (src / "lib" / "terrain" / "mesh_guided.glsl").is_file() else ())
+        extra_defines = {**extra_defines, "SV_TERRAIN_MESH": True}
+        # (sv_mesh_eye_inside is only a frame uniform: a spec uniform of that name would override it)
+        extra_uniforms = {**extra_uniforms, "sv_mesh_cells": check_degree(mesh_cells, "mesh_cells", low=0, high=64)}
     return ProgramSpec(
         name="terrain",
         entry="programs/terrain.glsl",
@@ -202,6 +234,7 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         },
         textures={"sv_terrain_minmax": table,
                   **{"sv_terrain_coef" + (str(k) if k else ""): piece for k, piece in enumerate(pieces)}},
+        **mesh_options,
     )
 
 
@@ -238,5 +271,5 @@ def _model_from(heights, scheme: str = "C1", presmooth: int = 0, **read_options)
 PROGRAM = SplineProgram(
     "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
     hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
-    options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug"),
+    options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug", "proxy", "mesh_samples", "mesh_cells"),
     description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")

@@ -1,0 +1,325 @@
+"""Mesh-guided exact rendering of a terrain spline (a prototype): the proxy is a lifted tessellation of the
+spline itself instead of its bounding box (program option ``proxy="mesh"`` of :mod:`splinevis.terrain.program`).
+
+What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_TERRAIN_MESH``):
+
+* **The lifted mesh.** The spline is sampled on a grid of ``k x k`` sub-squares per cell (``mesh_samples``),
+  each split along the cell's own diagonal direction (u = v), so every sub-triangle lies in one BB triangle
+  (T0 or T1) of one cell. Vertex heights are ``s(vertex) + lift(vertex)``, where ``lift(vertex)`` is the
+  largest cell lift (below) over the cells that touch the vertex: shared vertices get one height (the mesh
+  is watertight when rasterized) and every sub-triangle of cell c is lifted by at least that cell's lift.
+  Side walls go down from the border vertices to below the terrain's box, and a bottom face (a fan over the
+  walls' bottom vertices: no T-junction) closes the region R = {(x, y) in the domain, z_bottom <= z <=
+  mesh(x, y)}, outward oriented. Every vertex carries its cell (i, j) (flat attribute ``sv_mesh_cell``; -1 on
+  the walls and the bottom, whose fragments locate their cell from their position).
+* **The lift is a proof, not a guess.** On a sub-triangle T with vertices v_i and linear interpolant L of a
+  C2 function f, for x in T with x = sum lam_i v_i, Taylor's theorem at x gives
+  f(v_i) = f(x) + grad f(x).(v_i - x) + 1/2 (v_i - x)^T H(xi_i) (v_i - x); summing with weights lam_i
+  (sum lam_i (v_i - x) = 0): L(x) - f(x) = 1/2 sum lam_i (v_i - x)^T H(xi_i) (v_i - x), so
+  |f(x) - L(x)| <= M/2 sum lam_i |v_i - x|^2 <= M/2 R^2, with M a bound of the spectral norm of the Hessian
+  over T and R the circumradius of T (sum lam_i |v_i - x|^2 = R^2 - |x - centre|^2). A sub-triangle is a
+  right isosceles triangle with legs h = 1/k (index units), R^2 = h^2/2: the chord error is at most
+  M h^2 / 4. M is bounded from the BB coefficients: D_a D_b f of a quartic is the quadratic with BB
+  coefficients 12 (Delta_a Delta_b c) (second differences of the coefficients along the barycentric
+  directions a, b of index u and v), so by the convex hull property |f_uu| <= A, |f_uv| <= B, |f_vv| <= C
+  with A, B, C the largest magnitudes of those coefficients over the cell's two triangles, and by
+  Gershgorin M <= max(A, C) + B. The cell's lift is M h^2 / 4 plus a float32 margin (1e-5 of the height
+  span plus 1e-5 of the largest coordinate: the VBO holds float32 positions and the rasterizer
+  interpolates them; the horizontal part of that error moves the point vertically by up to the slope times it,
+  so the coordinate term is multiplied by 1 + |f_x| + |f_y|, bounded from the first differences). The bound
+  is per cell, hence valid for every scheme (no continuity across cell edges is used).
+* **The fragment.** With the eye outside R (decided per frame on the CPU, conservatively:
+  :meth:`LiftedMesh.eye_inside`), back faces are culled (``ProgramSpec.cull_per_frame``; the shader discards
+  them too) and front faces run the guided search: every ray that meets the surface enters R through a front face before it, at or after the
+  fragment's own point (t = 0 of the ray, which starts at the fragment). The search walks the cells along the
+  ray from the fragment's cell, ``mesh_cells`` cells at most, each bracketed by its prism (level-0 min/max) and
+  tested exactly as in the box program (restriction by blossoming, first root, both triangles); the first
+  hit found is the hit (cells are visited front to back). Leaving the domain is a miss (R lies over the
+  domain, a convex rectangle). When the cells run out, the full hierarchy walk (``sv_surface_hit`` of the box
+  program) continues from there. With the eye inside R (or close to it), front faces are culled and
+  back faces run the full ray cast from the eye (what the box proxy does: every ray leaves R through one). Normals, curvature, effects and
+  gl_FragDepth are computed as in the box program.
+
+What works, measured (llvmpipe):
+
+* Agreement with the float64 twin: all 43 terrain hard cases but the 2048^2 fractal (too large, below) pass
+  :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does (same one-sided
+  pixel counts, no leak, the same fraction of depths within the bound), at ``mesh_samples`` 2 with
+  ``mesh_cells`` 4 and at 1 with 1 (the fallback taken more often). tests/test_terrain_mesh_proxy.py checks 8
+  of them, and that the mesh lies above the spline on 40,000 random points of a crater in 4 schemes.
+* Speed: on the profile benchmark's full-screen C1 frame (benchmarks/bench_profile.py's scene, 800 x 600,
+  65 x 65 samples) the mesh proxy is slower than the box, and more so the finer the mesh (about 1.15x at
+  k = 1, 1.4x at k = 2, 2x at k = 4 on a shared machine; numbers in the commit that added this paragraph).
+  The walk it saves was 5 % of the frame; the restriction and the root finder (73 %) run as often as before,
+  on about 1.3 front-facing fragments per pixel instead of 1. That the cost grows with k suggests (not
+  measured) that llvmpipe shades partly covered pixel blocks along every triangle's edges in full, so small
+  triangles multiply this heavy shader's invocations. Culling the back faces per frame (rather than
+  discarding them in the shader) mattered: the discarded fragments had cost a third of the frame.
+
+What does not, or is not built:
+
+* Grids over :data:`MAX_MESH_CELLS` cells raise ``ValueError`` (the mesh has 2 k^2 triangles per cell and is
+  built in numpy at every ``terrain_program`` call): a coarser mesh over blocks of cells (each lifted to the
+  block's maximum, from the min/max pyramid) or a level of detail chosen from screen-space size is not built;
+  ``k`` is fixed per program.
+* The guidance does not yet shorten the root search: the first cell's segment starts at the fragment, but the
+  restricted quartic is still searched over the whole rest of the cell. Bracketing the root between the
+  fragment and the ray's exit from the mesh's lower envelope (a second mesh lowered by the same bound, where
+  the ray is known to be under the surface) would give the root finder one sign change on a short interval.
+* The near clipping plane: a front face of R in front of the near plane is clipped, and a pixel whose surface
+  hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the near
+  distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
+* Overdraw: every front face along a ray runs the search (gl_FragDepth is written, so there is no early depth
+  test); a depth pre-pass of the mesh with conservative depth (``depth_greater``) could reject the later ones.
+* No debug builds (``debug`` is refused with ``proxy="mesh"``); no frustum culling of the mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..bb import simplex as _simplex
+
+__all__ = ["second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
+
+#: Largest grid (cells) the mesh proxy builds a mesh for.
+MAX_MESH_CELLS = 512 * 512
+
+# d(lambda)/du, d(lambda)/dv of T0 = (1 - u, u - v, v) and T1 = (1 - v, u, v - u)
+_DU = np.array([[-1.0, 1.0, 0.0], [0.0, 1.0, -1.0]])
+_DV = np.array([[0.0, -1.0, 1.0], [-1.0, 0.0, 1.0]])
+
+
+def second_derivative_bounds(coefficients) -> np.ndarray:
+    """(ncy, ncx) bound M of the Hessian's spectral norm (index coordinates u, v; heights as stored) over each
+    cell: max(A, C) + B with A, B, C the largest |BB coefficient| of f_uu, f_uv, f_vv on T0 and T1.
+
+    Examples
+    --------
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> t = TerrainSpline.from_heights(x * x, "C1")   # f = u^2 (C1 reproduces cubics): f_uu = 2
+    >>> m = second_derivative_bounds(t.coefficients)
+    >>> bool(np.allclose(m, 2.0))
+    True
+    """
+    c = np.asarray(coefficients, dtype=np.float64)
+    bounds = []
+    for a, b in ((_DU, _DU), (_DU, _DV), (_DV, _DV)):
+        per_tri = []
+        for tri in (0, 1):
+            d1 = _simplex.derivative(c[..., tri, :], a[tri], d=2)
+            d2 = _simplex.derivative(d1, b[tri], d=2)
+            per_tri.append(np.abs(d2).max(axis=-1))
+        bounds.append(np.maximum(*per_tri))
+    A, B, C = bounds
+    return np.maximum(A, C) + B
+
+
+def cell_lifts(terrain, k: int) -> np.ndarray:
+    """(ncy, ncx) lift of each cell for ``k x k`` sub-squares per cell: M h^2 / 4 with h = 1/k (module
+    docstring), plus the float32 margin.
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> t = TerrainSpline.from_heights(x * x, "C1")
+    >>> lifts = cell_lifts(t, 2)  # the chord bound 2 (1/2)^2 / 4 = 0.125 and the float32 margin
+    >>> bool((lifts >= 0.125).all() and (lifts < 0.13).all())
+    True
+    """
+    c = terrain.coefficients
+    h = 1.0 / k
+    lift = second_derivative_bounds(c) * h * h / 4.0
+    x0, x1, y0, y1 = terrain.extent
+    span = float(c.max() - c.min())
+    coord = max(0.5 * (x1 - x0), 0.5 * (y1 - y0), float(np.abs(c).max()))
+    # the fragment's point (float32, interpolated) may sit off the mesh by ~1e-5 coord in any direction: on a
+    # slope of gradient g that moves it vertically by g times as much (the linear scheme's cliff leaked without)
+    sx, sy = terrain.cell_spacing
+    return lift + 1e-5 * span + 1e-5 * coord * (1.0 + gradient_bounds(c, sx, sy))
+
+
+def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarray:
+    """(ncy, ncx) bound of |f_x| + |f_y| (model units; cell size sx x sy) over each cell: the largest
+    |BB coefficient| of f_u and f_v (4 first differences) over T0 and T1, divided by the cell size.
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:4, 0:4].astype(float)
+    >>> bool(np.allclose(gradient_bounds(TerrainSpline.from_heights(3 * x - y, "C1").coefficients), 4.0))
+    True
+    """
+    c = np.asarray(coefficients, dtype=np.float64)
+    out = 0.0
+    for dirs, size in ((_DU, sx), (_DV, sy)):
+        out = out + np.maximum(*(np.abs(_simplex.derivative(c[..., tri, :], dirs[tri], d=2)).max(axis=-1)
+                                 for tri in (0, 1))) / size
+    return out
+
+
+@dataclass
+class LiftedMesh:
+    """The lifted mesh in the model frame: ``points`` (N, 3), ``triangles`` (M, 3), ``cells`` (N, 2) float
+    (cell i, j; -1 on the bottom face), ``top`` (ncy, ncx) highest lifted vertex of each cell (model z),
+    ``bottom`` (model z of the bottom face) and the model-frame extent (x0, x1, y0, y1)."""
+
+    points: np.ndarray
+    triangles: np.ndarray
+    cells: np.ndarray
+    top: np.ndarray
+    bottom: float
+    extent: tuple
+    k: int
+
+    def eye_inside(self, eye) -> bool:
+        """Whether ``eye`` (model frame) may lie inside the region under the mesh (conservative: within one
+        cell of the domain and below the highest lifted vertex of the 3 x 3 cells around it, plus a margin).
+
+        >>> from splinevis.terrain.model import TerrainSpline
+        >>> m = lifted_mesh(TerrainSpline.from_heights(np.zeros((5, 5)), "C1"), 2)
+        >>> m.eye_inside((0.0, 0.0, 0.5)), m.eye_inside((0.0, 0.0, 0.0)), m.eye_inside((0.0, 0.0, -0.5))
+        (False, True, False)
+        """
+        x0, x1, y0, y1 = self.extent
+        ncy, ncx = self.top.shape
+        sx, sy = (x1 - x0) / ncx, (y1 - y0) / ncy
+        ex, ey, ez = (float(v) for v in eye)
+        if not (x0 - sx <= ex <= x1 + sx and y0 - sy <= ey <= y1 + sy):
+            return False
+        i = int(np.clip(np.floor((ex - x0) / sx), 0, ncx - 1))
+        j = int(np.clip(np.floor((ey - y0) / sy), 0, ncy - 1))
+        top = float(self.top[max(j - 1, 0): j + 2, max(i - 1, 0): i + 2].max())
+        margin = 1e-4 * (abs(top) + abs(self.bottom) + 1.0)
+        return self.bottom - margin <= ez <= top + margin
+
+
+def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
+    """The lifted tessellation of ``terrain`` with ``k x k`` sub-squares per cell, side walls and a bottom face,
+    in the model frame (module docstring).
+
+    Examples
+    --------
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:4, 0:5].astype(float)
+    >>> t = TerrainSpline.from_heights(np.sin(x) + y, "C1")
+    >>> m = lifted_mesh(t, 2)
+    >>> m.points.shape, m.triangles.shape   # 12 cells x 9 vertices + walls + bottom
+    ((165, 3), (180, 3))
+    >>> u = np.random.default_rng(0).uniform(0, 1, (2000, 2))  # the mesh lies above the surface
+    >>> bool(mesh_above(t, m, u[:, 0] * 4, u[:, 1] * 3).min() > 0)
+    True
+    """
+    if k < 1:
+        raise ValueError(f"mesh_samples must be at least 1, got {k}.")
+    ncy, ncx = terrain.shape
+    if ncx * ncy > MAX_MESH_CELLS:
+        raise ValueError(f"proxy='mesh' builds meshes of at most {MAX_MESH_CELLS} cells; this terrain has "
+                         f"{ncx}x{ncy}: use the box proxy.")
+    off = terrain.offset
+    x0, x1, y0, y1 = terrain.extent
+    sx, sy = terrain.cell_spacing
+    lifts = cell_lifts(terrain, k)
+    # global sample grid (index coordinates a / k, b / k), heights in the model frame (relative to z_ref)
+    nu, nv = k * ncx + 1, k * ncy + 1
+    a = np.arange(nu) / k
+    b = np.arange(nv) / k
+    U, V = np.meshgrid(a, b)  # (nv, nu)
+    i = np.clip(np.floor(U).astype(np.int64), 0, ncx - 1)
+    j = np.clip(np.floor(V).astype(np.int64), 0, ncy - 1)
+    lu, lv = U - i, V - j
+    tri = (lv > lu).astype(np.int64)
+    from .model import cell_barycentric
+
+    lam = cell_barycentric(lu, lv, tri)
+    z = _simplex.de_casteljau(terrain.coefficients[j, i, tri], lam, d=2)
+    # vertex lift: the largest lift of the cells touching the vertex
+    pad = np.pad(lifts, 1, mode="edge")
+    touch = np.maximum(np.maximum(pad[:-1, :-1], pad[1:, :-1]), np.maximum(pad[:-1, 1:], pad[1:, 1:]))  # (ncy+1, ncx+1)
+    vl = np.zeros((nv, nu))
+    ci = np.minimum(np.arange(nu) // k, ncx - 1)
+    cj = np.minimum(np.arange(nv) // k, ncy - 1)
+    on_u = (np.arange(nu) % k) == 0
+    on_v = (np.arange(nv) % k) == 0
+    # inside a cell: the cell's lift; on a cell edge or corner: the max of the cells sharing it
+    vl[:] = lifts[cj][:, ci]
+    left = lifts[cj][:, np.maximum(ci - 1, 0)]
+    below = lifts[np.maximum(cj - 1, 0)][:, ci]
+    vl = np.where(on_u[None, :], np.maximum(vl, left), vl)
+    vl = np.where(on_v[:, None], np.maximum(vl, below), vl)
+    both = on_u[None, :] & on_v[:, None]
+    jj, ii = np.nonzero(both)
+    vl[jj, ii] = touch[jj // k, ii // k]
+    zl = z + vl
+    X = x0 - off[0] + U * sx
+    Y = y0 - off[1] + V * sy
+    # per-cell vertex blocks (vertices duplicated per cell so each carries its cell id)
+    s = np.arange(k + 1)
+    cj_all, ci_all = np.meshgrid(np.arange(ncy), np.arange(ncx), indexing="ij")
+    gb = cj_all[..., None, None] * k + s[None, None, :, None]   # (ncy, ncx, k+1, 1) global row
+    ga = ci_all[..., None, None] * k + s[None, None, None, :]   # (ncy, ncx, 1, k+1) global column
+    gb, ga = np.broadcast_arrays(gb, ga)
+    pts_top = np.stack([X[gb, ga], Y[gb, ga], zl[gb, ga]], axis=-1).reshape(-1, 3)
+    cell_top = np.stack([np.broadcast_to(ci_all[..., None, None], gb.shape),
+                         np.broadcast_to(cj_all[..., None, None], gb.shape)], axis=-1).reshape(-1, 2).astype(np.float64)
+    top = zl[gb, ga].reshape(ncy, ncx, -1).max(axis=-1)
+    # triangles per cell: sub-square (p, q) with corners v00, v10, v11, v01 (local grid index q * (k+1) + p);
+    # split along u = v: (v00, v10, v11) and (v00, v11, v01), counter-clockwise seen from above
+    p, q = np.meshgrid(np.arange(k), np.arange(k))
+    v00 = (q * (k + 1) + p).ravel()
+    v10, v01, v11 = v00 + 1, v00 + (k + 1), v00 + (k + 2)
+    local = np.concatenate([np.stack([v00, v10, v11], 1), np.stack([v00, v11, v01], 1)])
+    base = (np.arange(ncy * ncx) * (k + 1) ** 2)[:, None, None]
+    tris_top = (base + local[None]).reshape(-1, 3)
+    # walls and bottom
+    zb = float(terrain.coefficients.min()) - 1e-6 * max(1.0, float(np.ptp(terrain.coefficients))) - float(lifts.max())
+    ring = ([(a_, 0) for a_ in range(nu)] + [(nu - 1, b_) for b_ in range(1, nv)] +
+            [(a_, nv - 1) for a_ in range(nu - 2, -1, -1)] + [(0, b_) for b_ in range(nv - 2, 0, -1)])
+    ring = np.array(ring)  # counter-clockwise around the domain seen from above
+    ra, rb = ring[:, 0], ring[:, 1]
+    n0 = len(pts_top)
+    wall_top = np.stack([X[rb, ra], Y[rb, ra], zl[rb, ra]], axis=-1)
+    wall_bot = np.stack([X[rb, ra], Y[rb, ra], np.full(len(ring), zb)], axis=-1)
+    nr = len(ring)
+    idx = np.arange(nr)
+    nxt = (idx + 1) % nr
+    t_ = n0 + idx
+    b_ = n0 + nr + idx
+    # outward: for a counter-clockwise ring seen from above, (bottom_i, bottom_next, top_next), (bottom_i, top_next, top_i)
+    tris_wall = np.concatenate([np.stack([b_, n0 + nr + nxt, n0 + nxt], 1), np.stack([b_, n0 + nxt, t_], 1)])
+    # bottom: a fan from the centre over the walls' bottom vertices, facing down (the domain is convex); it shares
+    # the walls' bottom edges, so the closed mesh has no T-junction (four corner triangles left a crack)
+    nc = n0 + 2 * nr
+    bottom = np.array([[0.5 * (x0 + x1) - off[0], 0.5 * (y0 + y1) - off[1], zb]])
+    tris_bottom = np.stack([np.full(nr, nc), n0 + nr + nxt, n0 + nr + idx], 1)
+    points = np.concatenate([pts_top, wall_top, wall_bot, bottom])
+    # walls and bottom carry cell -1: their fragments locate their cell from their position (clamped)
+    cells = np.concatenate([cell_top, np.full((2 * nr + 1, 2), -1.0)])
+    triangles = np.concatenate([tris_top, tris_wall, tris_bottom]).astype(np.int64)
+    return LiftedMesh(points, triangles, cells, top, zb, (x0 - off[0], x1 - off[0], y0 - off[1], y1 - off[1]), k)
+
+
+def mesh_above(terrain, mesh: LiftedMesh, u, v) -> np.ndarray:
+    """Lifted mesh height minus spline height at index points (u, v) (model frame; positive: above), by
+    locating the sub-triangle of the top mesh (for tests).
+    """
+    ncy, ncx = terrain.shape
+    u = np.asarray(u, float)
+    v = np.asarray(v, float)
+    k = mesh.k
+    blocks = mesh.points[: (k + 1) ** 2 * ncx * ncy].reshape(ncy, ncx, k + 1, k + 1, 3)
+    i = np.clip(np.floor(u).astype(np.int64), 0, ncx - 1)
+    j = np.clip(np.floor(v).astype(np.int64), 0, ncy - 1)
+    fu, fv = (u - i) * k, (v - j) * k
+    p = np.clip(np.floor(fu).astype(np.int64), 0, k - 1)
+    q = np.clip(np.floor(fv).astype(np.int64), 0, k - 1)
+    s, t = fu - p, fv - q
+    z00 = blocks[j, i, q, p, 2]
+    z10 = blocks[j, i, q, p + 1, 2]
+    z01 = blocks[j, i, q + 1, p, 2]
+    z11 = blocks[j, i, q + 1, p + 1, 2]
+    zl = np.where(t <= s, z00 + s * (z10 - z00) + t * (z11 - z10), z00 + t * (z01 - z00) + s * (z11 - z01))
+    x0, _, y0, _ = terrain.extent
+    sx, sy = terrain.cell_spacing
+    f = terrain.evaluate(x0 + u * sx, y0 + v * sy) - terrain.z_ref
+    return zl - f
