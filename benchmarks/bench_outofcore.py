@@ -1,20 +1,24 @@
 """Benchmark: out-of-core stores of a large synthetic DEM (C1) and a large synthetic volume (quadratic).
 
     python benchmarks/bench_outofcore.py [--dem N] [--volume N] [--workers 1 2] [--out DIR]
+                                         [--dem-scheme C1] [--dem-tile 512] [--keep STORE]
+    python benchmarks/bench_outofcore.py --render STORE --out DIR
 
 Each configuration runs in a fresh Python process (its peak memory, ru_maxrss, is its own) on dask's threaded
 scheduler with 1 and 2 worker threads, writing to a temporary directory that is removed afterwards:
 
 * ``dem``: :func:`datasets_synthetic.large_grids.large_dem` (n x n, computed chunk by chunk, chunked along the tiles) to
-  :func:`splinevis.outofcore.write_terrain_store` with scheme C1 and tiles of 512 x 512 cells: wall seconds
-  (both passes: the mean and range, then coefficients + pyramid), tiles and million cells per second, MB on
-  disk, peak MB;
+  :func:`splinevis.outofcore.write_terrain_store` with scheme C1 (``--dem-scheme``) and tiles of 512 x 512 cells:
+  wall seconds (all passes: the mean, range and heights pyramid, then coefficients + pyramid), tiles and
+  million cells per second, MB on disk, peak MB (ru_maxrss of the process and its children);
 * ``volume``: :func:`datasets_synthetic.large_grids.large_volume` (n^3 Marschner-Lobb) to
   :func:`splinevis.outofcore.write_volume_store` (quadratic, tiles of 64^3 cubes): the same measures.
 
 The targets are a 16k x 16k DEM and a 1024^3 volume under 4 GB of peak memory. The C1 coefficients of a
 16k^2 DEM are 64 GB of float64 (the volume store of 1024^3 about 12 GB), minutes of work on a small machine,
-so the sizes are parameters; ``bench_outofcore(repeats, quick)`` is the case function in the style of
+so the sizes are parameters; ``--dem 16385 --dem-scheme C0`` builds the 16k DEM with 4 x 4 samples per cell
+(4 GB of coefficients). ``--keep STORE`` keeps the last DEM store, ``--render STORE`` draws it
+(:func:`render_store`: overview and a zoomed window, PNGs and the overview levels' errors); ``bench_outofcore(repeats, quick)`` is the case function in the style of
 ``benchmarks/run.py`` (quick: 2048^2 and 128^3) and ``outofcore_markdown(rows)`` its table.
 Results go to ``DIR/outofcore.json`` and ``DIR/outofcore.md``.
 """
@@ -35,14 +39,14 @@ from datasets_synthetic.large_grids import large_dem, large_volume
 from splinevis.outofcore import write_terrain_store, write_volume_store
 from splinevis.outofcore.terrain import terrain_input_chunks
 from splinevis.outofcore.volume import volume_input_chunks
-kind, n, workers, tile = {kind!r}, {n}, {workers}, {tile}
-tmp = Path(tempfile.mkdtemp(prefix="bench_outofcore_"))
+kind, n, workers, tile, scheme, keep = {kind!r}, {n}, {workers}, {tile}, {scheme!r}, {keep!r}
+tmp = Path(tempfile.mkdtemp(prefix="bench_outofcore_", dir=keep and str(Path(keep).parent)))
 try:
     with dask.config.set(scheduler="threads", num_workers=workers):
         t0 = time.perf_counter()
         if kind == "dem":
-            heights = large_dem(n, chunks=terrain_input_chunks((n, n), "C1", tile))
-            s = write_terrain_store(tmp / "s.zarr", heights, "C1", chunks=tile, spacing=(30.0, 30.0), progress=False)
+            heights = large_dem(n, chunks=terrain_input_chunks((n, n), scheme, tile))
+            s = write_terrain_store(tmp / "s.zarr", heights, scheme, chunks=tile, spacing=(30.0, 30.0), progress=False)
             tiles, cells = s.tiles[0] * s.tiles[1], s.shape[0] * s.shape[1]
         else:
             samples = large_volume(n, chunks=volume_input_chunks((n, n, n), tile))
@@ -50,17 +54,24 @@ try:
             tiles, cells = -(-n // tile) ** 3, n ** 3
         wall = time.perf_counter() - t0
     disk = sum(f.stat().st_size for f in tmp.rglob("*") if f.is_file())
+    if keep:
+        shutil.rmtree(keep, ignore_errors=True)
+        shutil.move(str(tmp / "s.zarr"), keep)
 finally:
     shutil.rmtree(tmp, ignore_errors=True)
+peak = max(resource.getrusage(who).ru_maxrss for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
 print(json.dumps({{"case": kind, "size": n, "workers": workers, "tile": tile, "tiles": tiles, "cells": cells,
+                  "scheme": scheme if kind == "dem" else "quadratic",
                   "wall_s": wall, "tiles_per_s": tiles / wall, "Mcells_per_s": cells / wall / 1e6,
-                  "disk_MB": disk / 2**20, "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}}))
+                  "disk_MB": disk / 2**20, "peak_MB": peak / 1024}}))
 '''
 
 
-def run_case(kind, n, workers, tile):
-    """One configuration in a fresh process: a dict of its measures."""
-    code = _CODE.format(kind=kind, n=int(n), workers=int(workers), tile=int(tile))
+def run_case(kind, n, workers, tile, scheme="C1", keep=None):
+    """One configuration in a fresh process: a dict of its measures (``keep``: move the store there instead
+    of deleting it)."""
+    code = _CODE.format(kind=kind, n=int(n), workers=int(workers), tile=int(tile), scheme=scheme,
+                        keep=str(keep) if keep else None)
     root = Path(__file__).resolve().parents[1]
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -83,11 +94,74 @@ def outofcore_markdown(rows):
              "| data | workers | tiles | wall s | tiles/s | Mcells/s | disk MB | peak MB |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        what = (f"DEM {r['size']}^2, C1, tiles {r['tile']}^2" if r["case"] == "dem"
+        what = (f"DEM {r['size']}^2, {r.get('scheme', 'C1')}, tiles {r['tile']}^2" if r["case"] == "dem"
                 else f"volume {r['size']}^3, quadratic, tiles {r['tile']}^3")
         lines.append(f"| {what} | {r['workers']} | {r['tiles']} | {r['wall_s']:.1f} | {r['tiles_per_s']:.2f} | "
                      f"{r['Mcells_per_s']:.2f} | {r['disk_MB']:.0f} | {r['peak_MB']:.0f} |")
     return "\n".join(lines) + "\n"
+
+
+def render_store(path, out, *, size=(1024, 768)):
+    """Draw a terrain store twice: an overview of all of it (the finest heights level within the default cell
+    budget) and a window of 2 x 2 tiles at the centre at full resolution (level 0); PNGs and a JSON of the
+    levels, tiles, cells, seconds and the overview levels' distance to the full-resolution surface over the
+    window (max and RMS over a 256 x 256 grid of points) go to ``out``."""
+    import time
+
+    import numpy as np
+
+    import splinevis
+    from splinevis.outofcore import open_terrain_store
+    from splinevis.outofcore.overview import _levels, overview_spline
+
+    s = open_terrain_store(path)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    x0, x1, y0, y1 = s.extent
+    zlo, zhi = s.data_range
+    info = {"store": repr(s), "data_range": s.data_range}
+    pl = splinevis.Plotter(off_screen=True, window_size=size)
+    t0 = time.perf_counter()
+    a = pl.add_terrain_store(s, "all", lights=1, colormap="terrain")
+    info["overview"] = {"level": a.store_view.level, "cells": a.store_view.cells, "load_s": time.perf_counter() - t0}
+    cx, cy, w = 0.5 * (x0 + x1), 0.5 * (y0 + y1), x1 - x0
+    pl.camera_position = [(cx - 0.3 * w, cy - 1.5 * w, 1.1 * w), (cx, cy + 0.05 * w, zlo), (0.0, 0.0, 1.0)]
+    pl.reset_camera_clipping_range()
+    t0 = time.perf_counter()
+    pl.screenshot(str(out / "dem16k_overview.png"))
+    info["overview"]["render_s"] = time.perf_counter() - t0
+    pl.close()
+    nty, ntx = s.tiles
+    ty, tx = s.tile
+    (dx, dy), (ox, oy) = s.cell_spacing, s.origin
+    iy, ix = nty // 2 - 1, ntx // 2 - 1
+    box = (ox + ix * tx * dx + 1, ox + (ix + 2) * tx * dx - 1, oy + iy * ty * dy + 1, oy + (iy + 2) * ty * dy - 1,
+           zlo - 1e4, zhi + 1e4)
+    pl = splinevis.Plotter(off_screen=True, window_size=size)
+    t0 = time.perf_counter()
+    a = pl.add_terrain_store(s, box, lights=1, colormap="terrain")
+    v = a.store_view
+    info["zoom"] = {"level": v.level, "tiles": v.tiles.tolist(), "read": v.read, "cells": v.cells,
+                    "load_s": time.perf_counter() - t0}
+    bw = box[1] - box[0]
+    zc = float(np.median(v.terrain.coefficients)) + s.z_ref
+    pl.camera_position = [(box[0] - 0.05 * bw, box[2] - 0.05 * bw, zc + 0.2 * bw),
+                          (box[0] + 0.5 * bw, box[2] + 0.5 * bw, zc), (0.0, 0.0, 1.0)]
+    pl.reset_camera_clipping_range()
+    t0 = time.perf_counter()
+    pl.screenshot(str(out / "dem16k_zoom_level0.png"))
+    info["zoom"]["render_s"] = time.perf_counter() - t0
+    pl.close()
+    # the overview levels against the full-resolution surface over the zoomed window
+    xs = np.linspace(box[0], box[1], 256)
+    X, Y = np.meshgrid(xs, np.linspace(box[2], box[3], 256))
+    full = v.terrain.evaluate(X, Y)
+    info["level_error_m"] = {}
+    for L in range(1, min(6, len(_levels(s))) + 1):
+        d = overview_spline(s, L, v.rows, v.cols).evaluate(X, Y) - full
+        info["level_error_m"][L] = {"max": float(np.abs(d).max()), "rms": float(np.sqrt((d * d).mean()))}
+    (out / "dem16k_render.json").write_text(json.dumps(info, indent=2))
+    return info
 
 
 def main(argv=None):
@@ -95,12 +169,20 @@ def main(argv=None):
     ap.add_argument("--dem", type=int, default=16384, help="DEM side in samples (0: skip)")
     ap.add_argument("--volume", type=int, default=1024, help="volume side in samples (0: skip)")
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--dem-scheme", default="C1", help="terrain scheme (C0: sizes 4k + 1, 4 x 4 samples a cell)")
+    ap.add_argument("--dem-tile", type=int, default=512, help="DEM tile in spline cells")
+    ap.add_argument("--keep", default=None, help="keep the last DEM store at this path (e.g. to render it)")
     ap.add_argument("--out", default="out/bench")
+    ap.add_argument("--render", default=None, help="draw this terrain store (overview + zoomed window) to --out")
     args = ap.parse_args(argv)
+    if args.render:
+        print(json.dumps(render_store(args.render, args.out), indent=1))
+        return 0
     rows = []
     for w in args.workers:
         if args.dem:
-            rows.append(run_case("dem", args.dem, w, 512))
+            keep = args.keep if w == args.workers[-1] else None
+            rows.append(run_case("dem", args.dem, w, args.dem_tile, args.dem_scheme, keep))
             print(json.dumps(rows[-1]), flush=True)
         if args.volume:
             rows.append(run_case("volume", args.volume, w, 64))

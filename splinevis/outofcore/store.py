@@ -8,11 +8,13 @@ Why our own code: zarr stores the chunks and dask writes them in parallel; what 
   the levels of ``TerrainSpline.hierarchy`` (the quantity the ray caster's traversal and the culling use);
 * ``tiles`` ``(nty, ntx, 2)``: (min, max) of each tile's coefficients, what :func:`~.view.tiles_in_view`
   tests against a view;
+* ``heights/L`` ``(ny_L, nx_L)``: every ``2^L``-th height sample (L >= 1), what overviews coarser than the
+  cells are built from (:mod:`.overview`);
 * attributes: ``scheme``, ``cell_spacing``, ``origin``, ``z_ref``, ``data_range``, ``cells``, ``tile``.
 
-Three passes: the mean height (``z_ref``) and the data range; the coefficients and the pyramid's level 0,
-tile by tile; the levels above and the tiles' bounds, reduced from level 0 as written (a sixteenth of the
-coefficients' bytes).
+Three passes: the mean height (``z_ref``), the data range and the heights pyramid; the coefficients and the
+pyramid's level 0, tile by tile; the levels above and the tiles' bounds, reduced from level 0 as written (a
+sixteenth of the coefficients' bytes).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .halo import as_dask_array
+from .overview import heights_levels
 from .pyramid import pyramid_levels_dask
 from .schedule import run
 from .terrain import _tiles, terrain_coefficients_dask
@@ -160,13 +163,16 @@ def write_terrain_store(path, heights, scheme="C1", *, chunks=512, spacing=(1.0,
         raise ValueError(f"heights must be a 2-D array of shape (ny, nx); got {h.ndim}-D shape {h.shape}.")
     ty, tx = _tiles(chunks)
     coef0 = terrain_coefficients_dask(h, scheme, chunks=(ty, tx))  # checks scheme, sizes, tiles first
-    mean, zmin, zmax = run(dask.delayed(tuple)([h.mean(), h.min(), h.max()]), progress=progress,
-                           label="terrain store: mean and range of the heights" if progress else "")
+    group = _group(path, "w")
+    # the heights pyramid (overview.py) is written in the pass that reads the heights for their mean
+    stats, _ = run([dask.delayed(tuple)([h.mean(), h.min(), h.max()]),
+                    _store(*heights_levels(h, scheme, group, _codecs(compressor)))], progress=progress,
+                   label="terrain store: mean and range of the heights, heights pyramid" if progress else "")
+    mean, zmin, zmax = stats
     z_ref = float(mean) if z_ref is None else float(z_ref)
     coef = terrain_coefficients_dask(h - z_ref, scheme, chunks=(ty, tx)) if z_ref != 0.0 else coef0
     cell = 4 if scheme == "C0" else 1
     ncy, ncx = coef.shape[:2]
-    group = _group(path, "w")
     group.attrs.update({
         "kind": _KIND, "scheme": scheme, "cell_spacing": [float(spacing[0]) * cell, float(spacing[1]) * cell],
         "origin": [float(origin[0]), float(origin[1])], "z_ref": z_ref,
