@@ -161,8 +161,14 @@ class Plotter(pv.Plotter):
         return spline
 
     def add_terrain(self, heights, scheme: str = "C1", style: Style | None = None, *, read_options: dict | None = None,
-                    presmooth: int = 0, **options):
+                    presmooth: int = 0, max_error_px: float | None = None, **options):
         """Build a terrain spline from height data and add it (see :meth:`add_spline` for ``options``).
+
+        ``max_error_px``: draw it the cheapest way whose screen-space error stays below that many pixels for
+        the current camera (set before the call; else the camera fitted to the terrain): a mesh of the spline
+        sampled k x k per cell (smallest k with a proven bound below it) or the exact ray cast
+        (:mod:`splinevis.choice`, ``docs/terrain-schemes.md``). The actor's ``renderer_choice`` says which, with
+        the error and the alternatives; a nonpositive or non-finite value raises ValueError.
 
         ``presmooth`` > 0 smooths noisy heights first with that many GPU passes of a binomial filter
         (:func:`splinevis.terrain.prefilter.smooth_heights`).
@@ -182,12 +188,43 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
+        if max_error_px is not None:
+            from .choice import add_by_accuracy
+
+            return add_by_accuracy(self, "terrain", (heights, scheme, presmooth), read_options, style, options,
+                                   max_error_px, style_from=_style_from)
         return self._add_from("terrain", (heights, scheme, presmooth), read_options, style, options)
+
+    def add_terrain_store(self, store, box=None, **options):
+        """Add the tiles of a terrain store (:mod:`splinevis.outofcore`) that the camera (or ``box``) sees, at
+        the finest level that fits (:func:`splinevis.outofcore.render.add_terrain_store`: ``max_cells``,
+        ``level`` and the options of :meth:`add_spline`). ``actor.store_view`` tells the level drawn.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> import numpy as np
+        >>> from splinevis.outofcore import write_terrain_store
+        >>> s = write_terrain_store(tempfile.mkdtemp() + "/t.zarr", np.eye(33), "C1", chunks=8, progress=False)
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> pl.add_terrain_store(s, (0.0, 10.0, 0.0, 10.0, -1.0, 2.0)).store_view.tiles.tolist()
+        [[0, 0], [0, 1], [1, 0], [1, 1]]
+        >>> pl.close()
+        """
+        from .outofcore.render import add_terrain_store
+
+        return add_terrain_store(self, store, box, **options)
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
-                       **options):
+                       max_error_px: float | None = None, **options):
         """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data [Kalbe2008].
+
+        ``max_error_px``: draw it the cheapest way whose screen-space error stays below that many pixels for
+        the current camera (set before the call; else the camera fitted to the volume): marching cubes of the
+        spline sampled k times per cube (smallest k whose estimated error is below it) or the ray cast
+        (:mod:`splinevis.choice`); the actor's ``renderer_choice`` says which. Nonpositive or non-finite
+        values raise ValueError.
 
         ``volume`` is a :class:`~splinevis.volume.VolumeSpline`, a :class:`~splinevis.io.VolumeGrid`, or
         anything :func:`splinevis.io.read_volume` reads (3-D array, pyvista ImageData, .vti/.nrrd/.mha/...
@@ -209,6 +246,12 @@ class Plotter(pv.Plotter):
         >>> len(actor.model.relevant.cubes) > 0
         True
         """
+        if max_error_px is not None:
+            from .choice import add_by_accuracy
+
+            return add_by_accuracy(self, "isosurface", (volume, isovalue, scheme), read_options, style,
+                                   dict(options, newton_iterations=newton_iterations), max_error_px,
+                                   style_from=_style_from, add_options={"culling": culling})
         return self._add_from("isosurface", (volume, isovalue, scheme), read_options, style,
                               dict(options, newton_iterations=newton_iterations), {"culling": culling})
 
