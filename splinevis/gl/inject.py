@@ -281,6 +281,7 @@ class SplineActor:
         # must precede everything, so it goes first.
         entry = '#include "lib/core/raycast.glsl"\n' + entry
         self.assembled = assemble(entry, defines, extra_roots=tuple(spec.glsl_roots))
+        self._entry, self._defines, self._variant = entry, defines, ()
 
         poly = vtkPolyData()
         mapper = vtkOpenGLPolyDataMapper()
@@ -325,6 +326,7 @@ class SplineActor:
         sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True, vs_dec, False)
         sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True, vs_impl, False)
         sp.AddFragmentShaderReplacement(_FS_DEC_TAG, True, fs_dec + self.assembled.text, False)
+        self._fs_dec = fs_dec
         impl = _FS_COUNTERS if kind == "raycast" and defines.get("SV_DEBUG_COUNTERS") else _FS_IMPL[kind]
         sp.AddFragmentShaderReplacement("//VTK::Depth::Impl", True, impl, False)
         sp.AddFragmentShaderReplacement("//VTK::Light::Impl", True, _FS_LIGHT, False)
@@ -344,16 +346,35 @@ class SplineActor:
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
         mapper.AddObserver(vtkCommand.UpdateShaderEvent, self._on_update_shader)
-        if spec.cull_per_frame is not None and renderer is not None:  # before each frame: see ProgramSpec
+        per_frame = spec.cull_per_frame is not None or spec.defines_per_frame is not None
+        if per_frame and renderer is not None:  # before each frame: see ProgramSpec
             renderer.AddObserver(vtkCommand.StartEvent, self._on_render_start)
 
     def _on_render_start(self, caller=None, event=None):
-        """Per-frame face culling of specs that ask for it (``ProgramSpec.cull_per_frame``)."""
+        """Per-frame face culling and build variant of specs that ask for them (``ProgramSpec.cull_per_frame``,
+        ``ProgramSpec.defines_per_frame``)."""
         eye, view, parallel, _ = self.camera_frame()
-        which = self.spec.cull_per_frame(eye, view, parallel)
-        prop = self.actor.GetProperty()
-        prop.SetFrontfaceCulling(which == "front")
-        prop.SetBackfaceCulling(which == "back")
+        if self.spec.cull_per_frame is not None:
+            which = self.spec.cull_per_frame(eye, view, parallel)
+            prop = self.actor.GetProperty()
+            prop.SetFrontfaceCulling(which == "front")
+            prop.SetBackfaceCulling(which == "back")
+        if self.spec.defines_per_frame is not None:
+            self.set_variant(self.spec.defines_per_frame(eye, view, parallel) or {})
+
+    def set_variant(self, extra_defines: dict) -> None:
+        """Rebuild the fragment code with ``extra_defines`` on top of the program's (a no-op when they are the
+        variant already drawn); VTK compiles the new source at the next render and keeps the old program."""
+        key = tuple(sorted(extra_defines.items()))
+        if key == self._variant:
+            return
+        self.assembled = assemble(self._entry, {**self._defines, **extra_defines},
+                                  extra_roots=tuple(self.spec.glsl_roots))
+        sp = self.actor.GetShaderProperty()
+        sp.ClearFragmentShaderReplacement(_FS_DEC_TAG, True)
+        sp.AddFragmentShaderReplacement(_FS_DEC_TAG, True, self._fs_dec + self.assembled.text, False)
+        self._variant = key
+        self.program_sources = {}
 
     @staticmethod
     def _per_vertex(spec):

@@ -47,6 +47,10 @@ class ProgramSpec:
         ``f(eye_mc, view_dir_mc, parallel) -> "front" | "back" | None``, called before every render of the
         actor's renderer: which faces to cull in this frame (None: none). The terrain's mesh proxy culls back
         faces while the eye is outside the region under its mesh and front faces while it may be inside.
+    defines_per_frame : callable, optional
+        ``f(eye_mc, view_dir_mc, parallel) -> dict`` of compile-time defines added to ``defines`` for this frame,
+        called before every render: a program with a rare special case (the eye inside the terrain's mesh
+        proxy) compiles it only while it applies, instead of carrying its code in every fragment.
     world_frame : (rotation (3, 3), pivot (3,)) or None
         For a model drawn in a rotated frame (a volume on a rotated orthogonal lattice): the actor maps model
         coordinates into the world by this rotation about ``pivot`` (:meth:`SplineActor.set_frame`).
@@ -82,3 +86,4 @@ class ProgramSpec:
     world_frame: tuple | None = None
     cull_front: bool | None = None
     cull_per_frame: Callable | None = None
+    defines_per_frame: Callable | None = None

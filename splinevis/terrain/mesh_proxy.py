@@ -82,7 +82,7 @@ import numpy as np
 
 from ..bb import simplex as _simplex
 
-__all__ = ["second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
+__all__ = ["triangle_hessian_bounds", "trace_bounds", "second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
 
 #: Largest grid (cells) the mesh proxy builds a mesh for.
 MAX_MESH_CELLS = 512 * 512
@@ -92,17 +92,18 @@ _DU = np.array([[-1.0, 1.0, 0.0], [0.0, 1.0, -1.0]])
 _DV = np.array([[0.0, -1.0, 1.0], [-1.0, 0.0, 1.0]])
 
 
-def second_derivative_bounds(coefficients) -> np.ndarray:
-    """(ncy, ncx) bound M of the Hessian's spectral norm (index coordinates u, v; heights as stored) over each
-    cell: max(A, C) + B with A, B, C the largest |BB coefficient| of f_uu, f_uv, f_vv on T0 and T1.
+def triangle_hessian_bounds(coefficients) -> np.ndarray:
+    """(ncy, ncx, 2) bound M of the Hessian's spectral norm (index coordinates u, v; heights as stored) on each
+    BB triangle T0, T1 of each cell: max(A, C) + B with A, B, C the largest |BB coefficient| of f_uu, f_uv, f_vv
+    (12 times the second differences of the coefficients along the barycentric directions of u and v; convex
+    hull property, Gershgorin). The mesh-guided tracing reads it per piece (module docstring).
 
     Examples
     --------
     >>> from splinevis.terrain.model import TerrainSpline
     >>> y, x = np.mgrid[0:6, 0:6].astype(float)
-    >>> t = TerrainSpline.from_heights(x * x, "C1")   # f = u^2 (C1 reproduces cubics): f_uu = 2
-    >>> m = second_derivative_bounds(t.coefficients)
-    >>> bool(np.allclose(m, 2.0))
+    >>> t = TerrainSpline.from_heights(x * y, "C1")   # f = u v: f_uu = f_vv = 0, f_uv = 1
+    >>> bool(np.allclose(triangle_hessian_bounds(t.coefficients), 1.0))
     True
     """
     c = np.asarray(coefficients, dtype=np.float64)
@@ -113,9 +114,25 @@ def second_derivative_bounds(coefficients) -> np.ndarray:
             d1 = _simplex.derivative(c[..., tri, :], a[tri], d=2)
             d2 = _simplex.derivative(d1, b[tri], d=2)
             per_tri.append(np.abs(d2).max(axis=-1))
-        bounds.append(np.maximum(*per_tri))
+        bounds.append(np.stack(per_tri, axis=-1))
     A, B, C = bounds
     return np.maximum(A, C) + B
+
+
+def second_derivative_bounds(coefficients) -> np.ndarray:
+    """(ncy, ncx) bound M of the Hessian's spectral norm over each cell: the larger of
+    :func:`triangle_hessian_bounds` over T0 and T1.
+
+    Examples
+    --------
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> t = TerrainSpline.from_heights(x * x, "C1")   # f = u^2 (C1 reproduces cubics): f_uu = 2
+    >>> m = second_derivative_bounds(t.coefficients)
+    >>> bool(np.allclose(m, 2.0))
+    True
+    """
+    return triangle_hessian_bounds(coefficients).max(axis=-1)
 
 
 def cell_lifts(terrain, k: int) -> np.ndarray:
@@ -139,6 +156,27 @@ def cell_lifts(terrain, k: int) -> np.ndarray:
     # slope of gradient g that moves it vertically by g times as much (the linear scheme's cliff leaked without)
     sx, sy = terrain.cell_spacing
     return lift + 1e-5 * span + 1e-5 * coord * (1.0 + gradient_bounds(c, sx, sy))
+
+
+def trace_bounds(terrain, k: int) -> np.ndarray:
+    """(ncy, ncx, 2) per cell: the Hessian bound M of :func:`second_derivative_bounds` (the tracing's step) and a
+    bound G of the lifted mesh's height above the spline on the cell (the tracing's exit: a ray higher than G
+    above the spline has left the region under the mesh). On a sub-triangle the mesh is the linear interpolant
+    of s + lift at its vertices, so mesh - s <= (chord error) + (largest vertex lift) <= M h^2 / 4 + the largest
+    cell lift among the 3 x 3 cells around (a vertex's lift is the largest of the cells touching it).
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> b = trace_bounds(TerrainSpline.from_heights(x * x, "C1"), 2)
+    >>> b.shape, bool(np.allclose(b[..., 0], 2.0)), bool((b[..., 1] >= 0.25).all())  # G >= chord + lift
+    ((5, 5, 2), True, True)
+    """
+    M = second_derivative_bounds(terrain.coefficients)
+    lifts = cell_lifts(terrain, k)
+    pad = np.pad(lifts, 1, mode="edge")
+    ny, nx = lifts.shape
+    near = np.max([pad[dy: dy + ny, dx: dx + nx] for dy in range(3) for dx in range(3)], axis=0)
+    return np.stack([M, M / (4.0 * k * k) + near], axis=-1)
 
 
 def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarray:

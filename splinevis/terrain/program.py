@@ -26,15 +26,18 @@ __all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_gri
 ROOTS = ("bracketed", "paper")
 #: Proxies of the program (option ``proxy``): the bounding box, or the lifted mesh (splinevis.terrain.mesh_proxy).
 PROXIES = ("box", "mesh")
+#: Hierarchy level whose blocks the mesh proxy's tracing skips when the ray passes one wholly on its side.
+MESH_SKIP_LEVEL = 2
 #: Debug builds of the program (option ``debug``; none is compiled unless asked for, see :func:`debug_defines`).
 DEBUG_MODES = ("counters", "flat", "restrict", "traversal", "raymarch")
 #: Levels the shader's hierarchy uniforms hold.
 MAX_LEVELS = 16
 
 
-def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
+def coefficient_table(terrain: TerrainSpline, spare=None) -> np.ndarray:
     """Table texture of the coefficients: 8 texels per cell, cells row after row (cell (i, j) is number
-    ``j ncx + i``), T0's 15 then T1's 15 coefficients, 2 zeros (:func:`splinevis.gl.proxies.pack_rgba32f`).
+    ``j ncx + i``), T0's 15 then T1's 15 coefficients, 2 zeros (:func:`splinevis.gl.proxies.pack_rgba32f`), or
+    instead of the zeros the two values per cell of ``spare`` (ncy, ncx, 2) (the mesh proxy's Hessian bounds).
 
     Examples
     --------
@@ -48,6 +51,8 @@ def coefficient_table(terrain: TerrainSpline) -> np.ndarray:
     ncy, ncx = terrain.shape
     flat = np.zeros((ncy, ncx, 32), dtype=np.float32)
     flat[..., :30] = terrain.coefficients.reshape(ncy, ncx, 30)
+    if spare is not None:
+        flat[..., 30:] = spare
     return pack_rgba32f(flat, name="terrain coefficient table", split=True)
 
 
@@ -128,7 +133,7 @@ def debug_defines(debug: str | None) -> tuple:
 def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: int = 8, max_steps: int | None = None,
                     hierarchy: bool | int = True, roots: str = "bracketed",
                     rows_per_texture: int = ROWS_PER_TEXTURE, debug: str | None = None, proxy: str = "box",
-                    mesh_samples: int = 2, mesh_cells: int = 4) -> ProgramSpec:
+                    mesh_samples: int = 1, mesh_steps: int = 32) -> ProgramSpec:
     """Describe the ray-cast program of ``terrain`` (glsl/programs/terrain.glsl).
 
     ``roots``: ``"bracketed"`` (default: bracketed Newton on convex pieces) or ``"paper"`` (Newton from four
@@ -138,10 +143,10 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     ``rows_per_texture``: rows of one texture of the coefficient table (default: 1 GiB textures; smaller
     values split small tables too, which the tests use to check the split path). ``debug``: None (default)
     or a debug build for profiling (:func:`debug_defines`). ``style`` decides nothing.
-    ``proxy``: ``"box"`` (default: one box around the terrain, drawn from its far side) or ``"mesh"`` (a
-    prototype: the lifted tessellation of :mod:`splinevis.terrain.mesh_proxy` with ``mesh_samples`` x
-    ``mesh_samples`` sub-squares per cell; each fragment searches ``mesh_cells`` cells along its ray from its
-    own point, then falls back to the full walk).
+    ``proxy``: ``"box"`` (default: one box around the terrain, drawn from its far side) or ``"mesh"`` (the
+    lifted tessellation of :mod:`splinevis.terrain.mesh_proxy` with ``mesh_samples`` x ``mesh_samples``
+    sub-squares per cell; each fragment traces its ray from its own point to the first root by steps that
+    cannot pass it, at most ``mesh_steps`` of them, then falls back to the full walk).
 
     The model frame is centred on the terrain (``terrain.offset``): the shader works in local
     coordinates whatever the data's origin.
@@ -167,7 +172,13 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     ncy, ncx = terrain.shape
     rows_per_texture = check_degree(rows_per_texture, "rows_per_texture", low=1, high=ROWS_PER_TEXTURE)
     check_grid_size(ncx, ncy, rows_per_texture)
-    pieces = split_table(coefficient_table(terrain), rows_per_texture)
+    spare = None
+    if proxy == "mesh":  # each cell's bounds for the tracing (mesh_proxy.trace_bounds), rounded up to float32
+        from .mesh_proxy import trace_bounds
+
+        k = check_degree(mesh_samples, "mesh_samples", low=1, high=16)
+        spare = np.nextafter(trace_bounds(terrain, k).astype(np.float32), np.float32(np.inf))
+    pieces = split_table(coefficient_table(terrain, spare), rows_per_texture)
     levels = terrain.hierarchy.levels
     if len(levels) > MAX_LEVELS:
         raise ValueError(f"terrain of {ncx}x{ncy} cells needs {len(levels)} hierarchy levels; at most {MAX_LEVELS} "
@@ -199,16 +210,17 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         # the repository's glsl/ first when the package runs from a source tree (a worktree whose editable
         # install points elsewhere); in an installed package the folder does not exist and is skipped
         src = Path(__file__).resolve().parents[2] / "glsl"
+        inside = lambda eye, parallel: not parallel and mesh.eye_inside(eye)
         mesh_options = dict(attributes={"sv_mesh_cell": mesh.cells}, cull_front=False,
-                            frame_uniforms=lambda eye, view: {"sv_mesh_eye_inside": int(mesh.eye_inside(eye))},
+                            defines_per_frame=lambda eye, view, parallel: (
+                                {"SV_TERRAIN_MESH_INSIDE": True} if inside(eye, parallel) else {}),
                             # the fragments of the faces the shader discards are not drawn at all (llvmpipe: the
                             # discarded back faces cost a third of the frame); the shader's test stays the rule
-                            cull_per_frame=lambda eye, view, parallel: (
-                                "front" if (not parallel and mesh.eye_inside(eye)) else "back"),
+                            cull_per_frame=lambda eye, view, parallel: "front" if inside(eye, parallel) else "back",
                             glsl_roots=(src,) if (src / "lib" / "terrain" / "mesh_guided.glsl").is_file() else ())
         extra_defines = {**extra_defines, "SV_TERRAIN_MESH": True}
-        # (sv_mesh_eye_inside is only a frame uniform: a spec uniform of that name would override it)
-        extra_uniforms = {**extra_uniforms, "sv_mesh_cells": check_degree(mesh_cells, "mesh_cells", low=0, high=64)}
+        extra_uniforms = {**extra_uniforms, "sv_mesh_steps": check_degree(mesh_steps, "mesh_steps", low=0, high=256),
+                          "sv_mesh_skip_level": min(MESH_SKIP_LEVEL, len(levels) - 1)}
     return ProgramSpec(
         name="terrain",
         entry="programs/terrain.glsl",
@@ -271,5 +283,5 @@ def _model_from(heights, scheme: str = "C1", presmooth: int = 0, **read_options)
 PROGRAM = SplineProgram(
     "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
     hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
-    options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug", "proxy", "mesh_samples", "mesh_cells"),
+    options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug", "proxy", "mesh_samples", "mesh_steps"),
     description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")
