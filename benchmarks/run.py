@@ -18,6 +18,8 @@ Cases
 * ``profile``: where a full-screen C1 terrain frame's time goes (``bench_profile.py``): the full program, shading
   replaced by a constant, the hierarchy walk alone and a reference ray march, in fragments/s and per llvmpipe
   thread (new processes at ``LP_NUM_THREADS=1`` and ``2``), with the per-fragment work counters of a debug build.
+* ``mesh_guided``: the mesh-guided terrain program (``proxy="mesh"``) against the box ray cast and a plain mesh of
+  the same triangles, full-screen C1 terrain, one run (``bench_mesh_guided.py``).
 * ``outofcore``: terrain and volume splines built tile by tile on dask and written to zarr
   (``bench_outofcore.py``): wall time, tiles/s at 1 and 2 workers, disk and peak memory of a fresh process.
 
@@ -241,6 +243,10 @@ def _markdown(results):
         from bench_profile import profile_markdown
 
         lines.append(profile_markdown(results["profile"]))
+    if "mesh_guided" in results:
+        from bench_mesh_guided import mesh_guided_markdown
+
+        lines.append(mesh_guided_markdown(results["mesh_guided"]))
     if "outofcore" in results:
         from bench_outofcore import outofcore_markdown
 
@@ -262,13 +268,14 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    from bench_mesh_guided import bench_mesh_guided
     from bench_outofcore import bench_outofcore
     from bench_profile import bench_profile
     from bench_scale import bench_cold_start, bench_large_terrain
 
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
              ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
-             ("profile", bench_profile), ("outofcore", bench_outofcore)]
+             ("profile", bench_profile), ("mesh_guided", bench_mesh_guided), ("outofcore", bench_outofcore)]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

@@ -28,6 +28,7 @@ from ..effects import Style
 from ..errors import ShaderCompileError
 from .assembler import Assembled, assemble
 from .spec import ProgramSpec
+from .textures import _colormap_image, _image_texture
 
 from vtkmodules.vtkCommonCore import VTK_OBJECT
 
@@ -118,32 +119,6 @@ def _float_texture(array: np.ndarray, name: str):
     if np.ndim(array) != 3 or np.shape(array)[2] != 4:
         raise ValueError(f"texture {name} must be (H, W, 4) float32, got {np.shape(array)}.")
     return to_vtk_texture(array, name=name)
-
-
-def _image_texture(image: np.ndarray, *, interpolate: bool, repeat: bool = False):
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkRenderingCore import vtkTexture
-
-    arr = np.ascontiguousarray(image[::-1])  # image rows run top-down, texture rows bottom-up
-    h, w, c = arr.shape
-    img = vtkImageData()
-    img.SetDimensions(w, h, 1)
-    img.GetPointData().SetScalars(numpy_to_vtk(arr.reshape(-1, c), deep=True))
-    tex = vtkTexture()
-    tex.SetInputData(img)
-    tex.SetColorModeToDirectScalars()
-    tex.SetInterpolate(bool(interpolate))
-    tex.SetRepeat(bool(repeat))
-    tex.EdgeClampOn() if not repeat else None
-    return tex
-
-
-def _colormap_image(name: str) -> np.ndarray:
-    import matplotlib
-
-    rgba = matplotlib.colormaps[name](np.linspace(0.0, 1.0, 256))
-    return (rgba[None, :, :] * 255 + 0.5).astype(np.uint8)
 
 
 class capture_vtk_errors:
@@ -364,7 +339,15 @@ class SplineActor:
 
     def set_variant(self, extra_defines: dict) -> None:
         """Rebuild the fragment code with ``extra_defines`` on top of the program's (a no-op when they are the
-        variant already drawn); VTK compiles the new source at the next render and keeps the old program."""
+        variant already drawn); VTK compiles the new source at the next render and keeps the old program.
+
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> actor = SplineActor(patch_program(QuarticTrianglePatch.demo()), Style(lights=1))
+        >>> actor.set_variant({"SV_EXAMPLE": 2})
+        >>> actor._variant, "#define SV_EXAMPLE 2" in actor.assembled.text
+        ((('SV_EXAMPLE', 2),), True)
+        """
         key = tuple(sorted(extra_defines.items()))
         if key == self._variant:
             return

@@ -233,3 +233,31 @@ def to_vtk_texture(values, **kwargs):
     tex.RepeatOff()
     tex.EdgeClampOn()
     return tex
+
+
+def _image_texture(image: np.ndarray, *, interpolate: bool, repeat: bool = False):
+    """An 8-bit image (H, W, C), top row first, as a VTK texture (colormaps, textures, environment maps)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkRenderingCore import vtkTexture
+
+    arr = np.ascontiguousarray(image[::-1])  # image rows run top-down, texture rows bottom-up
+    h, w, c = arr.shape
+    img = vtkImageData()
+    img.SetDimensions(w, h, 1)
+    img.GetPointData().SetScalars(numpy_to_vtk(arr.reshape(-1, c), deep=True))
+    tex = vtkTexture()
+    tex.SetInputData(img)
+    tex.SetColorModeToDirectScalars()
+    tex.SetInterpolate(bool(interpolate))
+    tex.SetRepeat(bool(repeat))
+    tex.EdgeClampOn() if not repeat else None
+    return tex
+
+
+def _colormap_image(name: str) -> np.ndarray:
+    """A matplotlib colormap as a 1 x 256 RGBA8 image."""
+    import matplotlib
+
+    rgba = matplotlib.colormaps[name](np.linspace(0.0, 1.0, 256))
+    return (rgba[None, :, :] * 255 + 0.5).astype(np.uint8)

@@ -1,7 +1,7 @@
-"""Mesh-guided exact rendering of a terrain spline (a prototype): the proxy is a lifted tessellation of the
-spline itself instead of its bounding box (program option ``proxy="mesh"`` of :mod:`splinevis.terrain.program`).
+"""Mesh-guided exact rendering of a terrain spline: the proxy is a lifted tessellation of the spline itself
+instead of its bounding box (program option ``proxy="mesh"`` of :mod:`splinevis.terrain.program`).
 
-What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_TERRAIN_MESH``):
+What is built here (Python) and in ``glsl/lib/terrain/mesh_guided.glsl``:
 
 * **The lifted mesh.** The spline is sampled on a grid of ``k x k`` sub-squares per cell (``mesh_samples``),
   each split along the cell's own diagonal direction (u = v), so every sub-triangle lies in one BB triangle
@@ -28,49 +28,47 @@ What is built here (Python) and in ``glsl/programs/terrain.glsl`` (section ``SV_
   interpolates them; the horizontal part of that error moves the point vertically by up to the slope times it,
   so the coordinate term is multiplied by 1 + |f_x| + |f_y|, bounded from the first differences). The bound
   is per cell, hence valid for every scheme (no continuity across cell edges is used).
-* **The fragment.** With the eye outside R (decided per frame on the CPU, conservatively:
-  :meth:`LiftedMesh.eye_inside`), back faces are culled (``ProgramSpec.cull_per_frame``; the shader discards
-  them too) and front faces run the guided search: every ray that meets the surface enters R through a front face before it, at or after the
-  fragment's own point (t = 0 of the ray, which starts at the fragment). The search walks the cells along the
-  ray from the fragment's cell, ``mesh_cells`` cells at most, each bracketed by its prism (level-0 min/max) and
-  tested exactly as in the box program (restriction by blossoming, first root, both triangles); the first
-  hit found is the hit (cells are visited front to back). Leaving the domain is a miss (R lies over the
-  domain, a convex rectangle). When the cells run out, the full hierarchy walk (``sv_surface_hit`` of the box
-  program) continues from there. With the eye inside R (or close to it), front faces are culled and
-  back faces run the full ray cast from the eye (what the box proxy does: every ray leaves R through one). Normals, curvature, effects and
-  gl_FragDepth are computed as in the box program.
+* **The fragment** (glsl/lib/terrain/mesh_guided.glsl; float64 twin :mod:`splinevis.terrain.trace`). With the
+  eye outside R (decided per frame on the CPU, conservatively: :meth:`LiftedMesh.eye_inside`), back faces are
+  culled (``ProgramSpec.cull_per_frame``) and every ray that meets the surface enters R through a front face
+  before it, at or after the fragment's own point (t = 0). From there the ray's height above the surface is
+  traced to its first zero by steps that cannot pass it (the bound of g'' from the piece's second differences
+  along the ray; derivation in :mod:`splinevis.terrain.trace`), stopping at piece borders, skipping blocks of
+  the min/max hierarchy the ray passes wholly on its side. A ray that rises above the mesh after having been
+  under it has left R: a miss here (the next front face along it starts its own trace). Where 32 steps
+  (``mesh_steps``) do not converge (a ray crawling past a near-double root, a grazing silhouette), the
+  fragment runs the full hierarchy walk from its point. Two things the rasterizer does had to be met: it
+  extrapolates positions past a triangle's edges (vertices snapped to subpixels), on a cliff by far more than
+  the lift, so a fragment may lie above the mesh (the exit test applies only once the ray was seen under the
+  mesh) or under the surface (it backs up along the ray); and a ray running along a cell edge or a diagonal
+  must read the piece ahead of it (its point is nudged along the ray by the walk's cell margin), or it steps
+  by a rounding error at a time. With the eye (possibly) inside R the actor compiles another build
+  (``ProgramSpec.defines_per_frame``): front faces culled, back faces run the full walk from the eye, as the box
+  does; the default build does not carry that walk in every fragment (llvmpipe runs both sides of a branch).
 
-What works, measured (llvmpipe):
+What works, measured (llvmpipe, 2 cores):
 
-* Agreement with the float64 twin: all 43 terrain hard cases but the 2048^2 fractal (too large, below) pass
-  :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does (same one-sided
-  pixel counts, no leak, the same fraction of depths within the bound), at ``mesh_samples`` 2 with
-  ``mesh_cells`` 4 and at 1 with 1 (the fallback taken more often). tests/test_terrain_mesh_proxy.py checks 8
-  of them, and that the mesh lies above the spline on 40,000 random points of a crater in 4 schemes.
-* Speed: on the profile benchmark's full-screen C1 frame (benchmarks/bench_profile.py's scene, 800 x 600,
-  65 x 65 samples) the mesh proxy is slower than the box, and more so the finer the mesh (about 1.15x at
-  k = 1, 1.4x at k = 2, 2x at k = 4 on a shared machine; numbers in the commit that added this paragraph).
-  The walk it saves was 5 % of the frame; the restriction and the root finder (73 %) run as often as before,
-  on about 1.3 front-facing fragments per pixel instead of 1. That the cost grows with k suggests (not
-  measured) that llvmpipe shades partly covered pixel blocks along every triangle's edges in full, so small
-  triangles multiply this heavy shader's invocations. Culling the back faces per frame (rather than
-  discarding them in the shader) mattered: the discarded fragments had cost a third of the frame.
+* Agreement with the float64 twin: all 43 terrain hard cases within the mesh cap (all but the 2048^2 fractal)
+  pass :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does, at
+  ``mesh_samples`` 1 and 32 steps (``python -c`` over ``splinevis.programs.get("terrain").hard_cases()`` with
+  ``program_options={"proxy": "mesh"}``; tests/test_terrain_mesh_proxy.py runs the 10 hardest). The tracing's
+  twin finds the reference's first root to 1e-8 on 3,000 rays per scheme over a crater and a cliff
+  (tests/test_terrain_trace.py).
+* Speed (benchmarks/bench_mesh_guided.py, full-screen C1 frame, 800 x 600): 2.5 to 4x faster than the box
+  proxy in the same run, depending on the load; but 10 to 13x slower than a plain mesh of the same triangles
+  (18 ms). The tracing itself costs a few loop iterations of one quartic evaluation; most of the rest is the
+  fallback walk's code, which llvmpipe executes (masked) in every 8-pixel group even when no fragment needs it.
 
 What does not, or is not built:
 
 * Grids over :data:`MAX_MESH_CELLS` cells raise ``ValueError`` (the mesh has 2 k^2 triangles per cell and is
-  built in numpy at every ``terrain_program`` call): a coarser mesh over blocks of cells (each lifted to the
-  block's maximum, from the min/max pyramid) or a level of detail chosen from screen-space size is not built;
-  ``k`` is fixed per program.
-* The guidance does not yet shorten the root search: the first cell's segment starts at the fragment, but the
-  restricted quartic is still searched over the whole rest of the cell. Bracketing the root between the
-  fragment and the ray's exit from the mesh's lower envelope (a second mesh lowered by the same bound, where
-  the ray is known to be under the surface) would give the root finder one sign change on a short interval.
+  built in numpy at every ``terrain_program`` call): a coarser mesh over blocks of cells or a level of detail
+  chosen from screen-space size is not built; ``k`` is fixed per program.
 * The near clipping plane: a front face of R in front of the near plane is clipped, and a pixel whose surface
   hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the near
   distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
-* Overdraw: every front face along a ray runs the search (gl_FragDepth is written, so there is no early depth
-  test); a depth pre-pass of the mesh with conservative depth (``depth_greater``) could reject the later ones.
+* Overdraw: every front face along a ray runs the trace (gl_FragDepth is written, so there is no early depth
+  test).
 * No debug builds (``debug`` is refused with ``proxy="mesh"``); no frustum culling of the mesh.
 """
 
@@ -200,7 +198,13 @@ def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarra
 class LiftedMesh:
     """The lifted mesh in the model frame: ``points`` (N, 3), ``triangles`` (M, 3), ``cells`` (N, 2) float
     (cell i, j; -1 on the bottom face), ``top`` (ncy, ncx) highest lifted vertex of each cell (model z),
-    ``bottom`` (model z of the bottom face) and the model-frame extent (x0, x1, y0, y1)."""
+    ``bottom`` (model z of the bottom face) and the model-frame extent (x0, x1, y0, y1).
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> m = lifted_mesh(TerrainSpline.from_heights(np.zeros((4, 5)), "C1"), 1)
+    >>> m.top.shape, m.k, bool(m.bottom < 0 < m.top.min())   # 3 x 4 cells, lifted above the plane z = 0
+    ((3, 4), 1, True)
+    """
 
     points: np.ndarray
     triangles: np.ndarray
@@ -340,6 +344,13 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
 def mesh_above(terrain, mesh: LiftedMesh, u, v) -> np.ndarray:
     """Lifted mesh height minus spline height at index points (u, v) (model frame; positive: above), by
     locating the sub-triangle of the top mesh (for tests).
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:4, 0:4].astype(float)
+    >>> t = TerrainSpline.from_heights(x - y, "linear")   # a plane: the mesh lies above by its lift only
+    >>> d = mesh_above(t, lifted_mesh(t, 1), [0.5, 1.5], [0.25, 2.5])
+    >>> bool((d > 0).all() and (d < 1e-3).all())
+    True
     """
     ncy, ncx = terrain.shape
     u = np.asarray(u, float)
