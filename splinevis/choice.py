@@ -360,12 +360,30 @@ def _iso_refuses(model, style):
 
 _MESH_K = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64)
 
-#: Renderers per program, any order (sorted by ``rank`` when used). A mesh-guided ray cast would be one more
-#: row, e.g. ``Renderer("mesh_guided", 20, (1, 2), raycast_error_px, build=...)`` whose build passes
-#: ``program_options={"proxy": "mesh", "mesh_samples": k}`` to ``add_spline``.
+
+def _add_mesh_guided(plotter, model, style, level, cache, spline_options, add_options):
+    options = dict(spline_options)
+    options["program_options"] = {**options.get("program_options", {}), "proxy": "mesh", "mesh_samples": 1}
+    return _add_raycast(plotter, model, style, level, cache, options, add_options)
+
+
+def _mesh_guided_refuses(model, style):
+    from .terrain.mesh_proxy import MAX_MESH_CELLS
+
+    ncy, ncx = model.shape
+    if ncx * ncy > MAX_MESH_CELLS:
+        return f"{ncx}x{ncy} cells: over the mesh proxy's {MAX_MESH_CELLS} cells"
+    return None
+
+
+#: Renderers per program, any order (sorted by ``rank`` when used). The mesh-guided ray cast draws the same
+#: picture as the ray cast (the same hard cases agree with the float64 twin) at 2.5-4x less time per frame on
+#: this machine (benchmarks/bench_mesh_guided.py), so it ranks between meshes and the box ray cast.
 RENDERERS = {
     "terrain": (
         Renderer("mesh", 0, _MESH_K, _terrain_mesh_error, _terrain_mesh_build, _terrain_mesh_triangles, _mesh_refuses),
+        Renderer("mesh_guided", 5, (None,), raycast_error_px, _add_mesh_guided, refuses=_mesh_guided_refuses,
+                 exact=True),
         Renderer("raycast", 10, (None,), raycast_error_px, _add_raycast, exact=True),
     ),
     "isosurface": (
@@ -485,7 +503,7 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
     saved.DeepCopy(cam)
     given = sorted({"program_options", "program"} & set(spline_options))
     exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in RENDERERS[program]
-               if given and r.triangles is not None}
+               if given and r.name != "raycast"}  # meshes take none; the mesh-guided build sets its own
     choice = choose(program, model, View.from_renderer(ren, plotter.window_size), max_error_px, st,
                     cache=(cache := {}), exclude=exclude)
     entry = next(r for r in RENDERERS[program] if r.name == choice.renderer)

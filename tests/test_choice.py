@@ -138,13 +138,13 @@ def _franke_like():
     return TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
 
 
-def test_choice_refines_the_mesh_then_switches_to_the_ray_cast():
+def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
     t = _franke_like()
     v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 5))
     cache = {}
     picks = [choose("terrain", t, v, e, triangle_cap=50_000, cache=cache) for e in (4.0, 1.0, 0.3, 0.1, 0.03, 0.02)]
     ks = [c.level for c in picks if c.renderer == "mesh"]
-    assert [c.renderer for c in picks] == ["mesh"] * 5 + ["raycast"]
+    assert [c.renderer for c in picks] == ["mesh"] * 5 + ["mesh_guided"]
     assert ks == sorted(ks) and ks[0] == 1 and ks[-1] > ks[0]
     for c in picks:
         assert c.meets and c.error_px <= c.max_error_px
@@ -155,9 +155,18 @@ def test_choice_refines_the_mesh_then_switches_to_the_ray_cast():
     # the chord bound scales as 1 / k^2: the mesh errors less the fixed float32 / snapping terms
     mesh = {o.level: o.error_px - SNAP_PX for o in picks[-1].options if o.name == "mesh" and not o.reason}
     assert mesh[2] / mesh[4] == pytest.approx(4.0, rel=0.05)
-    # nothing meets a request below the sub-pixel snapping: the exact ray cast is drawn and the choice says so
+    # nothing meets a request below the sub-pixel snapping: the cheapest exact ray cast is drawn and the choice
+    # says so; over the mesh proxy's cap that is the box ray cast
     c = choose("terrain", t, v, 1e-4, triangle_cap=50_000, cache=cache)
-    assert not c.meets and c.renderer == "raycast" and "nothing meets" in c.message
+    assert not c.meets and c.renderer == "mesh_guided" and "nothing meets" in c.message
+    import splinevis.terrain.mesh_proxy as mp
+
+    cap, mp.MAX_MESH_CELLS = mp.MAX_MESH_CELLS, 100
+    try:
+        c = choose("terrain", t, v, 1e-4, triangle_cap=50_000, cache={})
+    finally:
+        mp.MAX_MESH_CELLS = cap
+    assert c.renderer == "raycast" and "over the mesh proxy" in c.message
 
 
 @pytest.mark.parametrize("bad", [0, -1.0, math.nan, math.inf, "0.5", True])
@@ -175,7 +184,7 @@ def _foreground(image):
 
 
 @pytest.mark.parametrize("case, expected", [
-    ("terrain mesh", "mesh"), ("terrain colormap", "raycast"), ("sphere mesh", "mesh"), ("sphere fine", "raycast")])
+    ("terrain mesh", "mesh"), ("terrain colormap", "mesh_guided"), ("sphere mesh", "mesh"), ("sphere fine", "raycast")])
 def test_each_choice_renders(case, expected):
     pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
     if case.startswith("terrain"):
