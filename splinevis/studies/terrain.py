@@ -175,11 +175,12 @@ def mesh_normal_error(n, o, d):
     return _normal_angles(shown, _true_normals(p))
 
 
-def _scene_spline(terrain, iterations, style=None):
+def _scene_spline(terrain, iterations, style=None, program_options=None):
     from ..plotting import Plotter
 
     pl = Plotter(off_screen=True, window_size=WINDOW)
-    pl.add_spline(terrain, newton_iterations=iterations, **(style or dict(lights=1)))
+    pl.add_spline(terrain, newton_iterations=iterations, program_options=program_options or {},
+                  **(style or dict(lights=1)))
     pl.camera_position = CAMERA
     pl.camera.clipping_range = (0.05, 10.0)
     return pl
@@ -208,7 +209,8 @@ def accuracy_vs_time(*, quick=False, repeats=5, pixels=20_000, progress=True):
     schemes = ["linear", "C0", "C1", "C2", "C2-cubic"]
     data_n = 25 if quick else 33
     iterations = [1, 2, 3, 4, 6] if quick else [1, 2, 3, 4, 5, 6]
-    jobs = [("mesh", n, None) for n in mesh_sizes] + [("spline", s, k) for s in schemes for k in iterations]
+    jobs = ([("mesh", n, None) for n in mesh_sizes] + [("spline", s, k) for s in schemes for k in iterations]
+            + [("mesh-guided", s, None) for s in schemes])
     rows = []
     terrains = {s: franke_terrain(data_n, s) for s in schemes}
     for kind, a, b in progress_bar(jobs, "accuracy vs time", enabled=progress):
@@ -219,6 +221,14 @@ def accuracy_vs_time(*, quick=False, repeats=5, pixels=20_000, progress=True):
             err = mesh_normal_error(a, o, d)
             rows.append({"kind": "PyVista mesh", "config": f"{a}x{a} vertices", "elements": int(ntri),
                          **frames, **_stats(err)})
+        elif kind == "mesh-guided":
+            # the same picture as the box ray cast (the hard cases agree with the twin): the twin's error, its time
+            pl = _scene_spline(terrains[a], None, program_options={"proxy": "mesh"})
+            frames = timed(pl, repeats, with_repeats=False)
+            pl.close()
+            err = spline_normal_error(terrains[a], o, d, 8)
+            rows.append({"kind": f"mesh-guided {a}", "config": f"{data_n}x{data_n} data, proxy='mesh'",
+                         "elements": terrains[a].num_patches, "iterations": None, **frames, **_stats(err)})
         else:
             pl = _scene_spline(terrains[a], b)
             frames = timed(pl, repeats, with_repeats=False)
@@ -340,9 +350,16 @@ def pareto_figure(rows, path):
     for r in mesh:
         ax.annotate(f"{r['elements'] / 1e3:.0f}k tri", (r["frame_median_ms"], r["normal_err_median_deg"]), fontsize=7,
                     xytext=(3, 3), textcoords="offset points")
-    for kind in sorted({r["kind"] for r in rows if r["kind"] != "PyVista mesh"}):
+    for kind in sorted({r["kind"] for r in rows if r["kind"].startswith("spline")}):
         rs = sorted((r for r in rows if r["kind"] == kind), key=lambda r: r["iterations"])
         ax.plot([r["frame_median_ms"] for r in rs], [r["normal_err_median_deg"] for r in rs], "-s", label=f"{kind} (1..6 iterations)")
+    guided = [r for r in rows if r["kind"].startswith("mesh-guided")]
+    if guided:
+        ax.plot([r["frame_median_ms"] for r in guided], [r["normal_err_median_deg"] for r in guided], "r*", ms=11,
+                label="mesh-guided ray cast (same spline, proxy='mesh')")
+        for r in guided:
+            ax.annotate(r["kind"].split()[-1], (r["frame_median_ms"], r["normal_err_median_deg"]), fontsize=7,
+                        color="r", xytext=(4, -9), textcoords="offset points")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(f"frame time, median ms ({WINDOW[0]}x{WINDOW[1]}, llvmpipe)")
@@ -351,6 +368,25 @@ def pareto_figure(rows, path):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     save_figure(fig, path, dpi=110)
+
+
+def _write_pareto(out, result):
+    """From ``result["accuracy_vs_time"]``: the crossover rows (into ``result``), ``pareto.png`` and ``pareto.md``."""
+    out = Path(out)
+    result["crossover"] = crossover(result["accuracy_vs_time"])
+    pareto_figure(result["accuracy_vs_time"], out / "pareto.png")
+    (out / "pareto.md").write_text(
+        "# Accuracy vs time\n\n" + md_table(
+            result["accuracy_vs_time"],
+            [("renderer", "kind", "s"), ("config", "config", "s"), ("triangles/patches", "elements", "int"),
+             ("frame min ms", "frame_min_ms", "f1"), ("frame median ms", "frame_median_ms", "f1"),
+             ("normal err median °", "normal_err_median_deg", "e"), ("p95 °", "normal_err_p95_deg", "e")])
+        + "\n## Where the spline becomes cheaper\n\n" + md_table(
+            result["crossover"],
+            [("spline", "spline", "s"), ("iterations", "iterations", "s"), ("spline ms", "spline_ms", "f1"),
+             ("normal err °", "normal_err_median_deg", "e"), ("mesh ms for same error", "mesh_ms_for_same_error", "f1"),
+             ("mesh triangles for same error", "mesh_triangles_for_same_error", "int"), ("spline cheaper", "spline_cheaper", "s"),
+             ("note", "note", "s")]))
 
 
 def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
@@ -384,20 +420,7 @@ def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
           "scheme's 4x4 macro cells fit; the 13x13 row is the nearest size.\n")
     comparison_figure(out / "comparison_normals_shading_lines.png")
     result["accuracy_vs_time"] = accuracy_vs_time(quick=quick, progress=progress)
-    result["crossover"] = crossover(result["accuracy_vs_time"])
-    pareto_figure(result["accuracy_vs_time"], out / "pareto.png")
-    (out / "pareto.md").write_text(
-        "# Accuracy vs time\n\n" + md_table(
-            result["accuracy_vs_time"],
-            [("renderer", "kind", "s"), ("config", "config", "s"), ("triangles/patches", "elements", "int"),
-             ("frame min ms", "frame_min_ms", "f1"), ("frame median ms", "frame_median_ms", "f1"),
-             ("normal err median °", "normal_err_median_deg", "e"), ("p95 °", "normal_err_p95_deg", "e")])
-        + "\n## Where the spline becomes cheaper\n\n" + md_table(
-            result["crossover"],
-            [("spline", "spline", "s"), ("iterations", "iterations", "s"), ("spline ms", "spline_ms", "f1"),
-             ("normal err °", "normal_err_median_deg", "e"), ("mesh ms for same error", "mesh_ms_for_same_error", "f1"),
-             ("mesh triangles for same error", "mesh_triangles_for_same_error", "int"), ("spline cheaper", "spline_cheaper", "s"),
-             ("note", "note", "s")]))
+    _write_pareto(out, result)
     result["throughput"] = construction_throughput(n=257 if quick else 1025)
     (out / "throughput.md").write_text("# Construction throughput\n\n" + md_table(
         result["throughput"], [("scheme", "scheme", "s"), ("grid", "grid", "s"), ("patches", "patches", "int"),
