@@ -116,6 +116,40 @@ bool sv_clip_to_box(vec3 P0, vec3 D, float tmin, out float t, out float t_end) {
     return t <= t_end;
 }
 
+// Normal, scalar, uv and curvature of a hit at t_hit in cell cell_hit (index-space ray P0 + t D).
+void sv_terrain_fill_hit(vec3 ro, vec3 rd, vec3 P0, vec3 D, float t_hit, ivec2 cell_hit, inout SvHit hit) {
+    hit.t = t_hit;
+    hit.pos = ro + t_hit * rd;
+    vec3 P = P0 + t_hit * D;
+    vec2 local = P.xy - vec2(cell_hit);
+    int tri = local.y > local.x ? 1 : 0;
+    float b0[15];
+    float b1[15];
+    sv_load_cell(cell_hit, b0, b1);
+    float b[15];
+    for (int q = 0; q < 15; ++q) b[q] = tri == 0 ? b0[q] : b1[q];
+    vec3 l = sv_cell_bary(local, tri);
+    float f;
+    vec3 a;
+    float dd[6];
+    sv_tri_quartic_jet(b, l, f, a, dd);
+    vec3 du = sv_cell_bary(vec2(1.0, 0.0), tri) - sv_cell_bary(vec2(0.0), tri);
+    vec3 dv = sv_cell_bary(vec2(0.0, 1.0), tri) - sv_cell_bary(vec2(0.0), tri);
+    float fx = 4.0 * dot(du, a) * sv_index_scale.x;
+    float fy = 4.0 * dot(dv, a) * sv_index_scale.y;
+    hit.normal = vec3(-fx, -fy, 1.0);
+    hit.scalar = f + sv_scalar_offset;
+    hit.uv = P.xy / sv_ncells;
+#ifdef SV_OUT_CURVATURE
+    float fxx = sv_tri_quartic_d2(dd, du, du) * sv_index_scale.x * sv_index_scale.x;
+    float fxy = sv_tri_quartic_d2(dd, du, dv) * sv_index_scale.x * sv_index_scale.y;
+    float fyy = sv_tri_quartic_d2(dd, dv, dv) * sv_index_scale.y * sv_index_scale.y;
+    float g = 1.0 + fx * fx + fy * fy;
+    hit.curvature = vec2(((1.0 + fy * fy) * fxx - 2.0 * fx * fy * fxy + (1.0 + fx * fx) * fyy) / (2.0 * pow(g, 1.5)),
+                         (fxx * fyy - fxy * fxy) / (g * g));
+#endif
+}
+
 #ifdef SV_DEBUG_RAYMARCH
 // The reference ray march of the benchmarks (debug="raymarch"; benchmarks/bench_profile.py): the same ray in
 // index space and the same box clip, then sv_march_steps fixed steps through the box (no early exit), each
@@ -252,37 +286,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         }
     }
     if (t_hit == SV_NO_HIT) return false;
-
-    hit.t = t_hit;
-    hit.pos = ro + t_hit * rd;
-    vec3 P = P0 + t_hit * D;
-    vec2 local = P.xy - vec2(cell_hit);
-    int tri = local.y > local.x ? 1 : 0;
-    float b0[15];
-    float b1[15];
-    sv_load_cell(cell_hit, b0, b1);
-    float b[15];
-    for (int q = 0; q < 15; ++q) b[q] = tri == 0 ? b0[q] : b1[q];
-    vec3 l = sv_cell_bary(local, tri);
-    float f;
-    vec3 a;
-    float dd[6];
-    sv_tri_quartic_jet(b, l, f, a, dd);
-    vec3 du = sv_cell_bary(vec2(1.0, 0.0), tri) - sv_cell_bary(vec2(0.0), tri);
-    vec3 dv = sv_cell_bary(vec2(0.0, 1.0), tri) - sv_cell_bary(vec2(0.0), tri);
-    float fx = 4.0 * dot(du, a) * sv_index_scale.x;
-    float fy = 4.0 * dot(dv, a) * sv_index_scale.y;
-    hit.normal = vec3(-fx, -fy, 1.0);
-    hit.scalar = f + sv_scalar_offset;
-    hit.uv = P.xy / sv_ncells;
-#ifdef SV_OUT_CURVATURE
-    float fxx = sv_tri_quartic_d2(dd, du, du) * sv_index_scale.x * sv_index_scale.x;
-    float fxy = sv_tri_quartic_d2(dd, du, dv) * sv_index_scale.x * sv_index_scale.y;
-    float fyy = sv_tri_quartic_d2(dd, dv, dv) * sv_index_scale.y * sv_index_scale.y;
-    float g = 1.0 + fx * fx + fy * fy;
-    hit.curvature = vec2(((1.0 + fy * fy) * fxx - 2.0 * fx * fy * fxy + (1.0 + fx * fx) * fyy) / (2.0 * pow(g, 1.5)),
-                         (fxx * fyy - fxy * fxy) / (g * g));
-#endif
+    sv_terrain_fill_hit(ro, rd, P0, D, t_hit, cell_hit, hit);
     return true;
 }
 #endif
