@@ -367,23 +367,13 @@ def _add_mesh_guided(plotter, model, style, level, cache, spline_options, add_op
     return _add_raycast(plotter, model, style, level, cache, options, add_options)
 
 
-def _mesh_guided_refuses(model, style):
-    from .terrain.mesh_proxy import MAX_MESH_CELLS
-
-    ncy, ncx = model.shape
-    if ncx * ncy > MAX_MESH_CELLS:
-        return f"{ncx}x{ncy} cells: over the mesh proxy's {MAX_MESH_CELLS} cells"
-    return None
-
-
 #: Renderers per program, any order (sorted by ``rank`` when used). The mesh-guided ray cast draws the same
 #: picture as the ray cast (the same hard cases agree with the float64 twin) at 2.5-4x less time per frame on
 #: this machine (benchmarks/bench_mesh_guided.py), so it ranks between meshes and the box ray cast.
 RENDERERS = {
     "terrain": (
         Renderer("mesh", 0, _MESH_K, _terrain_mesh_error, _terrain_mesh_build, _terrain_mesh_triangles, _mesh_refuses),
-        Renderer("mesh_guided", 5, (None,), raycast_error_px, _add_mesh_guided, refuses=_mesh_guided_refuses,
-                 exact=True),
+        Renderer("mesh_guided", 5, (None,), raycast_error_px, _add_mesh_guided, exact=True),
         Renderer("raycast", 10, (None,), raycast_error_px, _add_raycast, exact=True),
     ),
     "isosurface": (

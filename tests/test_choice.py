@@ -156,17 +156,9 @@ def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
     mesh = {o.level: o.error_px - SNAP_PX for o in picks[-1].options if o.name == "mesh" and not o.reason}
     assert mesh[2] / mesh[4] == pytest.approx(4.0, rel=0.05)
     # nothing meets a request below the sub-pixel snapping: the cheapest exact ray cast is drawn and the choice
-    # says so; over the mesh proxy's cap that is the box ray cast
+    # says so
     c = choose("terrain", t, v, 1e-4, triangle_cap=50_000, cache=cache)
     assert not c.meets and c.renderer == "mesh_guided" and "nothing meets" in c.message
-    import splinevis.terrain.mesh_proxy as mp
-
-    cap, mp.MAX_MESH_CELLS = mp.MAX_MESH_CELLS, 100
-    try:
-        c = choose("terrain", t, v, 1e-4, triangle_cap=50_000, cache={})
-    finally:
-        mp.MAX_MESH_CELLS = cap
-    assert c.renderer == "raycast" and "over the mesh proxy" in c.message
 
 
 @pytest.mark.parametrize("bad", [0, -1.0, math.nan, math.inf, "0.5", True])

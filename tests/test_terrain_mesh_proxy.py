@@ -2,8 +2,8 @@
 the lifted mesh lies above the spline, the default program is unchanged, the eye-inside build is compiled only
 while the eye may be inside, and on the GPU a selection of the terrain's hard cases (those the tracing found
 hardest while it was built: grazing, flat, underside, C0 cliffs) agrees with the float64 twin as the box proxy's
-ray cast does. All 43 hard cases within the mesh cap agree (run them with splinevis.programs: see the module
-docstring of splinevis.terrain.mesh_proxy)."""
+ray cast does, also with a mesh over blocks of cells. All 44 hard cases agree (run them with splinevis.programs:
+see the module docstring of splinevis.terrain.mesh_proxy)."""
 
 import dataclasses
 
@@ -86,6 +86,20 @@ def test_eye_inside_build_only_while_the_eye_may_be_inside():
 @pytest.mark.parametrize("name", MESH_CASES)
 def test_mesh_proxy_agrees_with_the_twin(name):
     case = next(c for c in programs.get("terrain").hard_cases() if c.name == name)
+    case = dataclasses.replace(case, program_options={**case.program_options, "proxy": "mesh"})
+    r = hard_case_agreement(case)
+    assert agreement_failures(r, case) == []
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", ["cliff-C0-oblique", "crater-C1-oblique"])
+def test_block_mesh_agrees_with_the_twin(name, monkeypatch):
+    # a grid over MAX_MESH_CELLS gets one mesh square per block of cells (here blocks of 8 x 8 and 2 x 2)
+    import splinevis.terrain.mesh_proxy as mp
+
+    monkeypatch.setattr(mp, "MAX_MESH_CELLS", 300)
+    case = next(c for c in programs.get("terrain").hard_cases() if c.name == name)
+    assert mp.mesh_block(case.model()) > 1
     case = dataclasses.replace(case, program_options={**case.program_options, "proxy": "mesh"})
     r = hard_case_agreement(case)
     assert agreement_failures(r, case) == []

@@ -64,3 +64,23 @@ def test_exit_bound_holds_over_the_lifted_mesh(scheme, k):
     i = np.minimum(uv[:, 0].astype(int), ncx - 1)
     j = np.minimum(uv[:, 1].astype(int), ncy - 1)
     assert (above > 0).all() and (above <= G[j, i] * (1 + 1e-9)).all()
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_block_mesh_of_a_large_grid_lies_above_within_its_exit_bound(scheme, monkeypatch):
+    # grids over MAX_MESH_CELLS are drawn with one mesh square per block of B x B cells: the mesh still lies
+    # above the spline and within the exit bound G of every cell (Hessian bound for the C1 schemes, the block's
+    # coefficient range for all)
+    import splinevis.terrain.mesh_proxy as mp
+
+    monkeypatch.setattr(mp, "MAX_MESH_CELLS", 100)
+    t = TerrainSpline.from_heights(high_relief("crater", 65), scheme, spacing=(1.0, 1.0))
+    m = lifted_mesh(t, 1)
+    ncy, ncx = t.shape
+    assert m.block == mp.mesh_block(t) > 1 and (len(m.gu) - 1) * (len(m.gv) - 1) <= 100
+    G = trace_bounds(t, 1)[..., 1]
+    uv = np.random.default_rng(4).uniform(0.0, 1.0, (40_000, 2)) * (ncx, ncy)
+    above = mesh_above(t, m, uv[:, 0], uv[:, 1])
+    i = np.minimum(uv[:, 0].astype(int), ncx - 1)
+    j = np.minimum(uv[:, 1].astype(int), ncy - 1)
+    assert (above > 0).all() and (above <= G[j, i] * (1 + 1e-9)).all()

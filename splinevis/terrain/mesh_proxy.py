@@ -48,8 +48,9 @@ What is built here (Python) and in ``glsl/lib/terrain/mesh_guided.glsl``:
 
 What works, measured (llvmpipe, 2 cores):
 
-* Agreement with the float64 twin: all 43 terrain hard cases within the mesh cap (all but the 2048^2 fractal)
-  pass :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does, at
+* Agreement with the float64 twin: all 44 terrain hard cases (the 2048^2 fractal with a mesh over blocks of
+  4 x 4 cells; the other 43 also with the cap lowered to 300 squares, blocks of up to 8 x 8 cells) pass
+  :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does, at
   ``mesh_samples`` 1 and 32 steps (``python -c`` over ``splinevis.programs.get("terrain").hard_cases()`` with
   ``program_options={"proxy": "mesh"}``; tests/test_terrain_mesh_proxy.py runs the 10 hardest). The tracing's
   twin finds the reference's first root to 1e-8 on 3,000 rays per scheme over a crater and a cliff
@@ -61,9 +62,10 @@ What works, measured (llvmpipe, 2 cores):
 
 What does not, or is not built:
 
-* Grids over :data:`MAX_MESH_CELLS` cells raise ``ValueError`` (the mesh has 2 k^2 triangles per cell and is
-  built in numpy at every ``terrain_program`` call): a coarser mesh over blocks of cells or a level of detail
-  chosen from screen-space size is not built; ``k`` is fixed per program.
+* A level of detail chosen from the screen-space size is not built: ``k`` is fixed per program, and grids over
+  :data:`MAX_MESH_CELLS` cells get one square per block of B x B cells (:func:`mesh_block`), lifted by the
+  block's bound (the smaller of the Hessian bound, for the C1 schemes, and the block's coefficient range), whatever
+  the view.
 * The near clipping plane: a front face of R in front of the near plane is clipped, and a pixel whose surface
   hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the near
   distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
@@ -80,9 +82,9 @@ import numpy as np
 
 from ..bb import simplex as _simplex
 
-__all__ = ["triangle_hessian_bounds", "trace_bounds", "second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
+__all__ = ["triangle_hessian_bounds", "trace_bounds", "mesh_block", "C1_SCHEMES", "second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
 
-#: Largest grid (cells) the mesh proxy builds a mesh for.
+#: Most squares of the mesh proxy: a grid with more cells gets one square per block of cells (:func:`mesh_block`).
 MAX_MESH_CELLS = 512 * 512
 
 # d(lambda)/du, d(lambda)/dv of T0 = (1 - u, u - v, v) and T1 = (1 - v, u, v - u)
@@ -156,12 +158,84 @@ def cell_lifts(terrain, k: int) -> np.ndarray:
     return lift + 1e-5 * span + 1e-5 * coord * (1.0 + gradient_bounds(c, sx, sy))
 
 
+#: Schemes whose spline is C1 across cell edges: a mesh square spanning several cells may use the Hessian bound
+#: (Taylor's theorem with integral remainder needs f in C1 with piecewise bounded second derivatives).
+C1_SCHEMES = ("C1", "C2", "C2-cubic")
+
+
+def mesh_block(terrain, k: int = 1) -> int:
+    """Cells per side of a square of the mesh: 1 (``k x k`` sub-squares per cell) while the grid has at most
+    :data:`MAX_MESH_CELLS` cells, else the smallest power of two B with ceil(ncx / B) ceil(ncy / B) squares
+    within it (then ``k`` must be 1).
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> mesh_block(TerrainSpline.from_heights(np.zeros((9, 9)), "C1"))
+    1
+    """
+    ncy, ncx = terrain.shape
+    if ncx * ncy <= MAX_MESH_CELLS:
+        return 1
+    if k != 1:
+        raise ValueError(f"mesh_samples={k} on a grid of {ncx}x{ncy} cells: more than {MAX_MESH_CELLS} cells are "
+                         "drawn with one mesh square per block of cells; use mesh_samples=1.")
+    B = 2
+    while -(-ncx // B) * -(-ncy // B) > MAX_MESH_CELLS:
+        B *= 2
+    return B
+
+
+def _block_reduce(a, B, op):
+    """(ny, nx) -> (ceil(ny / B), ceil(nx / B)) by ``op`` (np.max or np.min) over B x B blocks (edge-padded)."""
+    ny, nx = a.shape
+    by, bx = -(-ny // B), -(-nx // B)
+    a = np.pad(a, ((0, by * B - ny), (0, bx * B - nx)), mode="edge")
+    return op(a.reshape(by, B, bx, B), axis=(1, 3))
+
+
+def _groups(terrain, k: int):
+    """The mesh's squares: corner lines ``gu`` (ngx + 1), ``gv`` (ngy + 1) in index units, sub-squares per square
+    ``kk``, the block size B and per square the chord bound and the lift (chord bound plus float32 margins).
+
+    B = 1: a square is a cell, every sub-triangle lies in one BB triangle: chord <= M h^2 / 4, h = 1 / k
+    (:func:`cell_lifts`). B > 1: a square spans B x B cells; its two triangles are right triangles with legs
+    hx, hy <= B, circumradius^2 (hx^2 + hy^2) / 4, so chord <= M (hx^2 + hy^2) / 8 with M the largest cell bound
+    of the block, for the C1 schemes; for every scheme chord <= max - min of the block's coefficients (the
+    interpolant and the spline both lie in that range); the smaller bound is used.
+    """
+    ncy, ncx = terrain.shape
+    B = mesh_block(terrain, k)
+    if B == 1:
+        M = second_derivative_bounds(terrain.coefficients)
+        return (np.arange(ncx + 1.0), np.arange(ncy + 1.0), k, 1, M / (4.0 * k * k), cell_lifts(terrain, k))
+    c = terrain.coefficients
+    gu = np.minimum(np.arange(-(-ncx // B) + 1) * B, ncx).astype(np.float64)
+    gv = np.minimum(np.arange(-(-ncy // B) + 1) * B, ncy).astype(np.float64)
+    hx, hy = np.diff(gu), np.diff(gv)
+    chord = _block_reduce(c.max(axis=(2, 3)), B, np.max) - _block_reduce(c.min(axis=(2, 3)), B, np.min)
+    if getattr(terrain, "scheme", None) in C1_SCHEMES:  # both bounds hold: the smaller
+        M = _block_reduce(second_derivative_bounds(c), B, np.max)
+        chord = np.minimum(chord, M * (hy[:, None] ** 2 + hx[None, :] ** 2) / 8.0)
+    x0, x1, y0, y1 = terrain.extent
+    span = float(c.max() - c.min())
+    coord = max(0.5 * (x1 - x0), 0.5 * (y1 - y0), float(np.abs(c).max()))
+    sx, sy = terrain.cell_spacing
+    grad = _block_reduce(gradient_bounds(c, sx, sy), B, np.max)
+    return gu, gv, 1, B, chord, chord + 1e-5 * span + 1e-5 * coord * (1.0 + grad)
+
+
+def _cells_of(a, B, shape):
+    """Per-square values (ngy, ngx) spread over the cells (ncy, ncx) of blocks of B x B cells."""
+    return np.repeat(np.repeat(a, B, axis=0), B, axis=1)[: shape[0], : shape[1]]
+
+
 def trace_bounds(terrain, k: int) -> np.ndarray:
     """(ncy, ncx, 2) per cell: the Hessian bound M of :func:`second_derivative_bounds` (the tracing's step) and a
     bound G of the lifted mesh's height above the spline on the cell (the tracing's exit: a ray higher than G
     above the spline has left the region under the mesh). On a sub-triangle the mesh is the linear interpolant
     of s + lift at its vertices, so mesh - s <= (chord error) + (largest vertex lift) <= M h^2 / 4 + the largest
-    cell lift among the 3 x 3 cells around (a vertex's lift is the largest of the cells touching it).
+    cell lift among the 3 x 3 cells around (a vertex's lift is the largest of the cells touching it); for a grid
+    drawn with squares of B x B cells (:func:`mesh_block`), the same over squares (:func:`_groups`), spread over
+    their cells.
 
     >>> from splinevis.terrain.model import TerrainSpline
     >>> y, x = np.mgrid[0:6, 0:6].astype(float)
@@ -170,11 +244,11 @@ def trace_bounds(terrain, k: int) -> np.ndarray:
     ((5, 5, 2), True, True)
     """
     M = second_derivative_bounds(terrain.coefficients)
-    lifts = cell_lifts(terrain, k)
+    _, _, _, B, chord, lifts = _groups(terrain, k)
     pad = np.pad(lifts, 1, mode="edge")
     ny, nx = lifts.shape
     near = np.max([pad[dy: dy + ny, dx: dx + nx] for dy in range(3) for dx in range(3)], axis=0)
-    return np.stack([M, M / (4.0 * k * k) + near], axis=-1)
+    return np.stack([M, _cells_of(chord + near, B, M.shape)], axis=-1)
 
 
 def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarray:
@@ -198,7 +272,8 @@ def gradient_bounds(coefficients, sx: float = 1.0, sy: float = 1.0) -> np.ndarra
 class LiftedMesh:
     """The lifted mesh in the model frame: ``points`` (N, 3), ``triangles`` (M, 3), ``cells`` (N, 2) float
     (cell i, j; -1 on the bottom face), ``top`` (ncy, ncx) highest lifted vertex of each cell (model z),
-    ``bottom`` (model z of the bottom face) and the model-frame extent (x0, x1, y0, y1).
+    ``bottom`` (model z of the bottom face), the model-frame extent (x0, x1, y0, y1), sub-squares per cell
+    ``k``, and the squares' size ``block`` (cells) and corner lines ``gu``, ``gv`` (index units).
 
     >>> from splinevis.terrain.model import TerrainSpline
     >>> m = lifted_mesh(TerrainSpline.from_heights(np.zeros((4, 5)), "C1"), 1)
@@ -213,6 +288,9 @@ class LiftedMesh:
     bottom: float
     extent: tuple
     k: int
+    block: int = 1
+    gu: np.ndarray | None = None
+    gv: np.ndarray | None = None
 
     def eye_inside(self, eye) -> bool:
         """Whether ``eye`` (model frame) may lie inside the region under the mesh (conservative: within one
@@ -255,17 +333,18 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     if k < 1:
         raise ValueError(f"mesh_samples must be at least 1, got {k}.")
     ncy, ncx = terrain.shape
-    if ncx * ncy > MAX_MESH_CELLS:
-        raise ValueError(f"proxy='mesh' builds meshes of at most {MAX_MESH_CELLS} cells; this terrain has "
-                         f"{ncx}x{ncy}: use the box proxy.")
     off = terrain.offset
     x0, x1, y0, y1 = terrain.extent
     sx, sy = terrain.cell_spacing
-    lifts = cell_lifts(terrain, k)
-    # global sample grid (index coordinates a / k, b / k), heights in the model frame (relative to z_ref)
-    nu, nv = k * ncx + 1, k * ncy + 1
-    a = np.arange(nu) / k
-    b = np.arange(nv) / k
+    # the squares: cells with k x k sub-squares, or blocks of B x B cells on grids over MAX_MESH_CELLS
+    gu, gv, kk, B, _, lifts = _groups(terrain, k)
+    ngy, ngx = lifts.shape
+    # global vertex lines (index coordinates), heights in the model frame (relative to z_ref)
+    nu, nv = kk * ngx + 1, kk * ngy + 1
+    ci = np.minimum(np.arange(nu) // kk, ngx - 1)  # the square of each vertex line
+    cj = np.minimum(np.arange(nv) // kk, ngy - 1)
+    a = gu[ci] + (gu[ci + 1] - gu[ci]) * (np.arange(nu) - ci * kk) / kk
+    b = gv[cj] + (gv[cj + 1] - gv[cj]) * (np.arange(nv) - cj * kk) / kk
     U, V = np.meshgrid(a, b)  # (nv, nu)
     i = np.clip(np.floor(U).astype(np.int64), 0, ncx - 1)
     j = np.clip(np.floor(V).astype(np.int64), 0, ncy - 1)
@@ -275,15 +354,13 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
 
     lam = cell_barycentric(lu, lv, tri)
     z = _simplex.de_casteljau(terrain.coefficients[j, i, tri], lam, d=2)
-    # vertex lift: the largest lift of the cells touching the vertex
+    # vertex lift: the largest lift of the squares touching the vertex
     pad = np.pad(lifts, 1, mode="edge")
-    touch = np.maximum(np.maximum(pad[:-1, :-1], pad[1:, :-1]), np.maximum(pad[:-1, 1:], pad[1:, 1:]))  # (ncy+1, ncx+1)
+    touch = np.maximum(np.maximum(pad[:-1, :-1], pad[1:, :-1]), np.maximum(pad[:-1, 1:], pad[1:, 1:]))  # (ngy+1, ngx+1)
     vl = np.zeros((nv, nu))
-    ci = np.minimum(np.arange(nu) // k, ncx - 1)
-    cj = np.minimum(np.arange(nv) // k, ncy - 1)
-    on_u = (np.arange(nu) % k) == 0
-    on_v = (np.arange(nv) % k) == 0
-    # inside a cell: the cell's lift; on a cell edge or corner: the max of the cells sharing it
+    on_u = (np.arange(nu) % kk) == 0
+    on_v = (np.arange(nv) % kk) == 0
+    # inside a square: the square's lift; on a square's edge or corner: the max of the squares sharing it
     vl[:] = lifts[cj][:, ci]
     left = lifts[cj][:, np.maximum(ci - 1, 0)]
     below = lifts[np.maximum(cj - 1, 0)][:, ci]
@@ -291,27 +368,27 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     vl = np.where(on_v[:, None], np.maximum(vl, below), vl)
     both = on_u[None, :] & on_v[:, None]
     jj, ii = np.nonzero(both)
-    vl[jj, ii] = touch[jj // k, ii // k]
+    vl[jj, ii] = touch[jj // kk, ii // kk]
     zl = z + vl
     X = x0 - off[0] + U * sx
     Y = y0 - off[1] + V * sy
-    # per-cell vertex blocks (vertices duplicated per cell so each carries its cell id)
-    s = np.arange(k + 1)
-    cj_all, ci_all = np.meshgrid(np.arange(ncy), np.arange(ncx), indexing="ij")
-    gb = cj_all[..., None, None] * k + s[None, None, :, None]   # (ncy, ncx, k+1, 1) global row
-    ga = ci_all[..., None, None] * k + s[None, None, None, :]   # (ncy, ncx, 1, k+1) global column
+    # per-square vertex blocks (vertices duplicated per square so each carries its first cell's id)
+    s = np.arange(kk + 1)
+    cj_all, ci_all = np.meshgrid(np.arange(ngy), np.arange(ngx), indexing="ij")
+    gb = cj_all[..., None, None] * kk + s[None, None, :, None]   # (ngy, ngx, kk+1, 1) global row
+    ga = ci_all[..., None, None] * kk + s[None, None, None, :]   # (ngy, ngx, 1, kk+1) global column
     gb, ga = np.broadcast_arrays(gb, ga)
     pts_top = np.stack([X[gb, ga], Y[gb, ga], zl[gb, ga]], axis=-1).reshape(-1, 3)
-    cell_top = np.stack([np.broadcast_to(ci_all[..., None, None], gb.shape),
-                         np.broadcast_to(cj_all[..., None, None], gb.shape)], axis=-1).reshape(-1, 2).astype(np.float64)
-    top = zl[gb, ga].reshape(ncy, ncx, -1).max(axis=-1)
-    # triangles per cell: sub-square (p, q) with corners v00, v10, v11, v01 (local grid index q * (k+1) + p);
+    cell_top = np.stack([np.broadcast_to(ci_all[..., None, None] * B, gb.shape),
+                         np.broadcast_to(cj_all[..., None, None] * B, gb.shape)], axis=-1).reshape(-1, 2).astype(np.float64)
+    top = _cells_of(zl[gb, ga].reshape(ngy, ngx, -1).max(axis=-1), B, (ncy, ncx))
+    # triangles per square: sub-square (p, q) with corners v00, v10, v11, v01 (local grid index q * (kk+1) + p);
     # split along u = v: (v00, v10, v11) and (v00, v11, v01), counter-clockwise seen from above
-    p, q = np.meshgrid(np.arange(k), np.arange(k))
-    v00 = (q * (k + 1) + p).ravel()
-    v10, v01, v11 = v00 + 1, v00 + (k + 1), v00 + (k + 2)
+    p, q = np.meshgrid(np.arange(kk), np.arange(kk))
+    v00 = (q * (kk + 1) + p).ravel()
+    v10, v01, v11 = v00 + 1, v00 + (kk + 1), v00 + (kk + 2)
     local = np.concatenate([np.stack([v00, v10, v11], 1), np.stack([v00, v11, v01], 1)])
-    base = (np.arange(ncy * ncx) * (k + 1) ** 2)[:, None, None]
+    base = (np.arange(ngy * ngx) * (kk + 1) ** 2)[:, None, None]
     tris_top = (base + local[None]).reshape(-1, 3)
     # walls and bottom
     zb = float(terrain.coefficients.min()) - 1e-6 * max(1.0, float(np.ptp(terrain.coefficients))) - float(lifts.max())
@@ -338,7 +415,8 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     # walls and bottom carry cell -1: their fragments locate their cell from their position (clamped)
     cells = np.concatenate([cell_top, np.full((2 * nr + 1, 2), -1.0)])
     triangles = np.concatenate([tris_top, tris_wall, tris_bottom]).astype(np.int64)
-    return LiftedMesh(points, triangles, cells, top, zb, (x0 - off[0], x1 - off[0], y0 - off[1], y1 - off[1]), k)
+    return LiftedMesh(points, triangles, cells, top, zb, (x0 - off[0], x1 - off[0], y0 - off[1], y1 - off[1]), k,
+                      B, gu, gv)
 
 
 def mesh_above(terrain, mesh: LiftedMesh, u, v) -> np.ndarray:
@@ -352,16 +430,17 @@ def mesh_above(terrain, mesh: LiftedMesh, u, v) -> np.ndarray:
     >>> bool((d > 0).all() and (d < 1e-3).all())
     True
     """
-    ncy, ncx = terrain.shape
     u = np.asarray(u, float)
     v = np.asarray(v, float)
-    k = mesh.k
-    blocks = mesh.points[: (k + 1) ** 2 * ncx * ncy].reshape(ncy, ncx, k + 1, k + 1, 3)
-    i = np.clip(np.floor(u).astype(np.int64), 0, ncx - 1)
-    j = np.clip(np.floor(v).astype(np.int64), 0, ncy - 1)
-    fu, fv = (u - i) * k, (v - j) * k
-    p = np.clip(np.floor(fu).astype(np.int64), 0, k - 1)
-    q = np.clip(np.floor(fv).astype(np.int64), 0, k - 1)
+    kk = mesh.k if mesh.block == 1 else 1
+    gu, gv = mesh.gu, mesh.gv
+    ngx, ngy = len(gu) - 1, len(gv) - 1
+    blocks = mesh.points[: (kk + 1) ** 2 * ngx * ngy].reshape(ngy, ngx, kk + 1, kk + 1, 3)
+    i = np.clip(np.searchsorted(gu, u, side="right") - 1, 0, ngx - 1)
+    j = np.clip(np.searchsorted(gv, v, side="right") - 1, 0, ngy - 1)
+    fu, fv = (u - gu[i]) / (gu[i + 1] - gu[i]) * kk, (v - gv[j]) / (gv[j + 1] - gv[j]) * kk
+    p = np.clip(np.floor(fu).astype(np.int64), 0, kk - 1)
+    q = np.clip(np.floor(fv).astype(np.int64), 0, kk - 1)
     s, t = fu - p, fv - q
     z00 = blocks[j, i, q, p, 2]
     z10 = blocks[j, i, q, p + 1, 2]
