@@ -3,6 +3,7 @@
     python benchmarks/bench_outofcore.py [--dem N] [--volume N] [--workers 1 2] [--out DIR]
                                          [--dem-scheme C1] [--dem-tile 512] [--keep STORE]
     python benchmarks/bench_outofcore.py --render STORE --out DIR
+    python benchmarks/bench_outofcore.py --render-volume STORE [--isovalue 0.5] --out DIR
 
 Each configuration runs in a fresh Python process (its peak memory, ru_maxrss, is its own) on dask's threaded
 scheduler with 1 and 2 worker threads, writing to a temporary directory that is removed afterwards:
@@ -17,9 +18,11 @@ scheduler with 1 and 2 worker threads, writing to a temporary directory that is 
 The targets are a 16k x 16k DEM and a 1024^3 volume under 4 GB of peak memory. The C1 coefficients of a
 16k^2 DEM are 64 GB of float64 (the volume store of 1024^3 about 12 GB), minutes of work on a small machine,
 so the sizes are parameters; ``--dem 16385 --dem-scheme C0`` builds the 16k DEM with 4 x 4 samples per cell
-(4 GB of coefficients). ``--keep STORE`` keeps the last DEM store, ``--render STORE`` draws it
-(:func:`render_store`: overview and a zoomed window, PNGs and the overview levels' errors); ``bench_outofcore(repeats, quick)`` is the case function in the style of
-``benchmarks/run.py`` (quick: 2048^2 and 128^3) and ``outofcore_markdown(rows)`` its table.
+(4 GB of coefficients). ``--keep STORE`` keeps the last DEM store (with ``--dem 0`` the volume store),
+``--render STORE`` draws it (:func:`render_store`: overview and a zoomed window, PNGs and the overview levels'
+errors), ``--render-volume STORE`` an isosurface of a volume store (:func:`render_volume_store`: overview at a
+decimated level and a zoomed window at full resolution); ``bench_outofcore(repeats, quick)`` is the case
+function in the style of ``benchmarks/run.py`` (quick: 2048^2 and 128^3) and ``outofcore_markdown(rows)`` its table.
 Results go to ``DIR/outofcore.json`` and ``DIR/outofcore.md``.
 """
 
@@ -30,6 +33,8 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+
+import numpy as np
 
 _CODE = r'''
 import json, resource, shutil, tempfile, time
@@ -164,6 +169,77 @@ def render_store(path, out, *, size=(1024, 768)):
     return info
 
 
+def render_volume_store(path, out, isovalue=0.5, *, size=(1024, 768), prefix="vol1024"):
+    """Draw the isosurface ``isovalue`` of a volume store twice: an overview of all of it (the finest
+    decimated level within the default cube budget) and a window of 2 x 2 x 2 bricks at the centre at full
+    resolution (level 0, only its bricks read); PNGs and a JSON of the levels, bricks, cubes, relevant
+    cubes, load and draw seconds, the decimated levels' distance to the full-resolution spline over the window
+    (max and RMS of values at 20000 random points) and the peak memory go to ``out``."""
+    import resource
+    import time
+
+    import splinevis
+    from splinevis.outofcore import open_volume_store
+
+    s = open_volume_store(path)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    info = {"store": repr(s), "isovalue": isovalue}
+    (x0, y0, z0), (dx, dy, dz) = s.origin, s.spacing
+    nz, ny, nx = s.shape
+    ext = np.array([nx * dx, ny * dy, nz * dz])
+    lo = np.array([x0, y0, z0]) - 0.5 * np.array([dx, dy, dz])
+
+    def shoot(name, box, camera):
+        pl = splinevis.Plotter(off_screen=True, window_size=size)
+        if box is None:  # the camera's view: set it first
+            pl.camera_position = camera
+        t0 = time.perf_counter()
+        a = pl.add_isosurface_store(s, isovalue, box, lights=1)
+        v = a.store_view
+        rec = {"box": box, "level": v.level, "bricks_in_view": len(v.bricks), "bricks_read": v.read,
+               "cubes": [[q.start, q.stop] for q in v.cubes], "shape": list(v.shape),
+               "relevant_cubes": len(v.isosurface.relevant.cubes), "load_s": time.perf_counter() - t0}
+        pl.camera_position = camera
+        pl.reset_camera_clipping_range()
+        t0 = time.perf_counter()
+        pl.screenshot(str(out / f"{prefix}_{name}.png"))
+        rec["draw_s"] = time.perf_counter() - t0
+        pl.close()
+        info[name] = rec
+        print(name, rec, flush=True)
+
+    c = lo + 0.5 * ext
+    w = float(ext.max())
+    shoot("overview", "all", [tuple(c + np.array([1.3, -1.9, 1.2]) * w), tuple(c), (0.0, 0.0, 1.0)])
+    info["overview"]["camera"] = "all of it"
+    t = np.array(s.tiles[::-1])  # bricks along x, y, z; the window: 2 x 2 x 2 of them, at 3/4 of x
+    b0 = lo + np.array([3 * t[0] // 4 - 1, t[1] // 2 - 1, t[2] // 2 - 1]) * np.array(s.tile[::-1]) * (dx, dy, dz)
+    t = np.array(s.tile[::-1]) * np.array([dx, dy, dz])  # brick size (x, y, z)
+    b1 = b0 + 2 * t
+    box = tuple(float(v) for pair in zip(b0 + 0.25, b1 - 0.25) for v in pair)
+    bc, bw = 0.5 * (b0 + b1), float((b1 - b0).max())
+    shoot("zoom_level0", box, [tuple(bc + np.array([2.0, -1.2, 1.3]) * bw), tuple(bc), (0.0, 0.0, 1.0)])
+    # a camera above the zoomed window choosing the bricks itself (its four side planes)
+    shoot("camera", None, [tuple(bc + np.array([0.3, -0.6, 1.6]) * bw), tuple(bc), (0.0, 0.0, 1.0)])
+    # the decimated levels against the full-resolution spline over the zoomed window (values at random points)
+    from splinevis.outofcore.render_volume import load_volume_view, view_bricks
+
+    bricks = view_bricks(s, isovalue, box)
+    v0 = load_volume_view(s, isovalue, bricks, level=0)
+    b = v0.isosurface.spline.bounds
+    rng = np.random.default_rng(0)
+    pts = np.array(b[::2]) + 0.5 + rng.random((20000, 3)) * (np.array(b[1::2]) - np.array(b[::2]) - 1.0)
+    full = v0.isosurface.spline.evaluate(pts)
+    info["level_error"] = {}
+    for L in range(1, 5):
+        d = load_volume_view(s, isovalue, bricks, level=L).isosurface.spline.evaluate(pts) - full
+        info["level_error"][L] = {"max": float(np.abs(d).max()), "rms": float(np.sqrt((d * d).mean()))}
+    info["peak_MB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    (out / f"{prefix}_render.json").write_text(json.dumps(info, indent=2))
+    return info
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dem", type=int, default=16384, help="DEM side in samples (0: skip)")
@@ -171,12 +247,19 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--dem-scheme", default="C1", help="terrain scheme (C0: sizes 4k + 1, 4 x 4 samples a cell)")
     ap.add_argument("--dem-tile", type=int, default=512, help="DEM tile in spline cells")
-    ap.add_argument("--keep", default=None, help="keep the last DEM store at this path (e.g. to render it)")
+    ap.add_argument("--keep", default=None, help="keep the last DEM store (with --dem 0: the volume store) at this "
+                    "path (e.g. to render it)")
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--render", default=None, help="draw this terrain store (overview + zoomed window) to --out")
+    ap.add_argument("--render-volume", default=None, help="draw an isosurface of this volume store (overview + "
+                    "zoomed window) to --out")
+    ap.add_argument("--isovalue", type=float, default=0.5, help="isovalue for --render-volume")
     args = ap.parse_args(argv)
     if args.render:
         print(json.dumps(render_store(args.render, args.out), indent=1))
+        return 0
+    if args.render_volume:
+        print(json.dumps(render_volume_store(args.render_volume, args.out, args.isovalue), indent=1))
         return 0
     rows = []
     for w in args.workers:
@@ -185,7 +268,8 @@ def main(argv=None):
             rows.append(run_case("dem", args.dem, w, args.dem_tile, args.dem_scheme, keep))
             print(json.dumps(rows[-1]), flush=True)
         if args.volume:
-            rows.append(run_case("volume", args.volume, w, 64))
+            keep = args.keep if w == args.workers[-1] and not args.dem else None  # the DEM's if both
+            rows.append(run_case("volume", args.volume, w, 64, keep=keep))
             print(json.dumps(rows[-1]), flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -215,6 +215,28 @@ class Plotter(pv.Plotter):
 
         return add_terrain_store(self, store, box, **options)
 
+    def add_isosurface_store(self, store, isovalue, box=None, **options):
+        """Add the isosurface ``s = isovalue`` of the bricks of a volume store (:mod:`splinevis.outofcore`) that
+        hold it and that the camera (or ``box``) sees, at the finest level that fits
+        (:func:`splinevis.outofcore.render_volume.add_volume_store`: ``max_cubes``, ``level`` and the options
+        of :meth:`add_spline`). ``actor.store_view`` tells the level and bricks drawn.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> import numpy as np
+        >>> from splinevis.outofcore import write_volume_store
+        >>> z, y, x = np.mgrid[0:16, 0:16, 0:16].astype(float)
+        >>> s = write_volume_store(tempfile.mkdtemp() + "/v.zarr", x, chunks=8, progress=False)
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> pl.add_isosurface_store(s, 4.5, (0.0, 15.0, 0.0, 5.0, 0.0, 15.0)).store_view.bricks.tolist()
+        [[0, 0, 0], [1, 0, 0]]
+        >>> pl.close()
+        """
+        from .outofcore.render_volume import add_volume_store
+
+        return add_volume_store(self, store, isovalue, box, **options)
+
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
                        max_error_px: float | None = None, **options):

@@ -218,6 +218,44 @@ class VolumeStore:
         data = block[idx[..., 2], idx[..., 1], idx[..., 0]]
         return (data @ W.reshape(-1, 27).T).reshape(-1, 24, W.shape[1])
 
+    @property
+    def tiles(self) -> tuple:
+        """``(ntz, nty, ntx)`` tiles (bricks) of the store.
+
+        >>> import tempfile
+        >>> write_volume_store(tempfile.mkdtemp() + "/v.zarr", np.zeros((5, 4, 3)), chunks=2, progress=False).tiles
+        (3, 2, 2)
+        """
+        return tuple(-(-n // t) for n, t in zip(self.shape, self.tile))
+
+    def window(self, k0, k1, j0, j1, i0, i1):
+        """The tiles ``[k0, k1) x [j0, j1) x [i0, i1)`` (z, y, x) as an in-memory
+        :class:`~splinevis.volume.model.VolumeSpline`: the stored padded data of their cubes and one layer
+        around them (the neighbouring samples inside the volume, the store's padding at its border), so its
+        coefficients are the whole volume's spline's, bit for bit. Reads those tiles' chunks and the next
+        chunk along each axis (the layer above them).
+
+        >>> import tempfile
+        >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
+        >>> s = write_volume_store(tempfile.mkdtemp() + "/v.zarr", x * y - z, chunks=4, origin=(10.0, 0.0, 0.0),
+        ...                        progress=False)
+        >>> w = s.window(1, 2, 0, 1, 1, 2)  # cubes 4..7 (z), 0..3 (y), 4..7 (x)
+        >>> w.shape, w.origin.tolist(), round(float(w.evaluate([[15.25, 2.5, 4.75]])[0]), 9)
+        ((4, 4, 4), [14.0, 0.0, 4.0], 8.375)
+        """
+        from ..volume.model import VolumeSpline
+
+        ntz, nty, ntx = self.tiles
+        if not (0 <= k0 < k1 <= ntz and 0 <= j0 < j1 <= nty and 0 <= i0 < i1 <= ntx):
+            raise ValueError(f"window tiles [{k0}, {k1}) x [{j0}, {j1}) x [{i0}, {i1}) (z, y, x) must be non-empty "
+                             f"and inside the store's {ntz}x{nty}x{ntx} tiles.")
+        (a0, a1), (b0, b1), (c0, c1) = [(lo * t, min(hi * t, n)) for lo, hi, t, n in
+                                        zip((k0, j0, i0), (k1, j1, i1), self.tile, self.shape)]
+        P = self.padded[a0:a1 + 2, b0:b1 + 2, c0:c1 + 2]  # cube c's sample is padded[c + 1]
+        org = tuple(o + c * d for o, c, d in zip(self.origin, (c0, b0, a0), self.spacing))
+        return VolumeSpline.from_padded(P, self.scheme, spacing=self.spacing, origin=org,
+                                        source=f"{self.path} tiles [{k0}:{k1}, {j0}:{j1}, {i0}:{i1}]")
+
     def __repr__(self):
         nz, ny, nx = self.shape
         tz, ty, tx = self.tile

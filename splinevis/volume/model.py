@@ -136,6 +136,37 @@ class VolumeSpline:
         self._octree = None
         self.setup_seconds = time.perf_counter() - t0
 
+    @classmethod
+    def from_padded(cls, padded, scheme: str = "quadratic", *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
+                    source: str = "padded data") -> "VolumeSpline":
+        """The spline of given padded data ``(nz + 2, ny + 2, nx + 2)`` (the samples and one layer around them,
+        kept as given: a window of a larger volume pads with the neighbouring samples, not extrapolation).
+
+        >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
+        >>> full = VolumeSpline(x * y + z)
+        >>> w = VolumeSpline.from_padded(full.padded[2:7, 1:6, 0:5], origin=(0.0, 1.0, 2.0))  # cubes z 2..4, y 1..3
+        >>> w.shape, bool((w.cube_coefficients([[1, 1, 1]]) == full.cube_coefficients([[1, 2, 3]])).all())
+        ((3, 3, 3), True)
+        """
+        if scheme not in SCHEME_DEGREE:
+            raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
+        P = np.ascontiguousarray(padded, dtype=np.float64)
+        if P.ndim != 3 or min(P.shape) < MIN_SAMPLES + 2:
+            raise ValueError(f"padded data must be 3-D with at least {MIN_SAMPLES + 2} samples along every axis "
+                             f"(the samples and one layer around them), got shape {P.shape}.")
+        if not np.isfinite(P).all():
+            raise ValueError("padded data must be finite.")
+        self = cls.__new__(cls)
+        self.grid = VolumeGrid(P[1:-1, 1:-1, 1:-1], spacing=tuple(spacing), origin=tuple(origin), source=source)
+        self.scheme = scheme
+        self.degree = SCHEME_DEGREE[scheme]
+        self.weights = tet_weights(scheme)
+        self.ncoef = self.weights.shape[1]
+        self.padded = P
+        self._octree = None
+        self.setup_seconds = 0.0
+        return self
+
     # ------------------------------------------------------------------ geometry
     @property
     def shape(self) -> tuple:
