@@ -329,13 +329,14 @@ class SplineActor:
         """Per-frame face culling and build variant of specs that ask for them (``ProgramSpec.cull_per_frame``,
         ``ProgramSpec.defines_per_frame``)."""
         eye, view, parallel, _ = self.camera_frame()
+        near = float(self.renderer.GetActiveCamera().GetClippingRange()[0])
         if self.spec.cull_per_frame is not None:
-            which = self.spec.cull_per_frame(eye, view, parallel)
+            which = self.spec.cull_per_frame(eye, view, parallel, near)
             prop = self.actor.GetProperty()
             prop.SetFrontfaceCulling(which == "front")
             prop.SetBackfaceCulling(which == "back")
         if self.spec.defines_per_frame is not None:
-            self.set_variant(self.spec.defines_per_frame(eye, view, parallel) or {})
+            self.set_variant(self.spec.defines_per_frame(eye, view, parallel, near) or {})
 
     def set_variant(self, extra_defines: dict) -> None:
         """Rebuild the fragment code with ``extra_defines`` on top of the program's (a no-op when they are the

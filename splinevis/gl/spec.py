@@ -44,11 +44,12 @@ class ProgramSpec:
         Whether the actor culls front faces (None: the kind's default, culled for ray-cast proxies drawn from
         their far side; False: neither). ``cull_per_frame``, when given, decides instead, every frame.
     cull_per_frame : callable, optional
-        ``f(eye_mc, view_dir_mc, parallel) -> "front" | "back" | None``, called before every render of the
+        ``f(eye_mc, view_dir_mc, parallel, near) -> "front" | "back" | None`` (``near``: the near clipping
+        distance), called before every render of the
         actor's renderer: which faces to cull in this frame (None: none). The terrain's mesh proxy culls back
         faces while the eye is outside the region under its mesh and front faces while it may be inside.
     defines_per_frame : callable, optional
-        ``f(eye_mc, view_dir_mc, parallel) -> dict`` of compile-time defines added to ``defines`` for this frame,
+        ``f(eye_mc, view_dir_mc, parallel, near) -> dict`` of compile-time defines added to ``defines`` for this frame,
         called before every render: a program with a rare special case (the eye inside the terrain's mesh
         proxy) compiles it only while it applies, instead of carrying its code in every fragment.
     world_frame : (rotation (3, 3), pivot (3,)) or None

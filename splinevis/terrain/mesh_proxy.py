@@ -292,26 +292,47 @@ class LiftedMesh:
     gu: np.ndarray | None = None
     gv: np.ndarray | None = None
 
-    def eye_inside(self, eye) -> bool:
-        """Whether ``eye`` (model frame) may lie inside the region under the mesh (conservative: within one
-        cell of the domain and below the highest lifted vertex of the 3 x 3 cells around it, plus a margin).
+    def eye_inside(self, eye, reach: float = 0.0) -> bool:
+        """Whether ``eye`` (model frame) may lie inside the region under the mesh, or within ``reach`` of it
+        (conservative: within one cell (plus ``reach``) of the domain and below the highest lifted vertex of the
+        3 x 3 cells around it, plus a margin and ``reach``).
 
         >>> from splinevis.terrain.model import TerrainSpline
         >>> m = lifted_mesh(TerrainSpline.from_heights(np.zeros((5, 5)), "C1"), 2)
         >>> m.eye_inside((0.0, 0.0, 0.5)), m.eye_inside((0.0, 0.0, 0.0)), m.eye_inside((0.0, 0.0, -0.5))
         (False, True, False)
+        >>> m.eye_inside((0.0, 0.0, 0.5), reach=0.6)
+        True
         """
         x0, x1, y0, y1 = self.extent
         ncy, ncx = self.top.shape
         sx, sy = (x1 - x0) / ncx, (y1 - y0) / ncy
         ex, ey, ez = (float(v) for v in eye)
-        if not (x0 - sx <= ex <= x1 + sx and y0 - sy <= ey <= y1 + sy):
+        if not (x0 - sx - reach <= ex <= x1 + sx + reach and y0 - sy - reach <= ey <= y1 + sy + reach):
             return False
+        ri, rj = int(np.ceil(reach / sx)) + 1, int(np.ceil(reach / sy)) + 1
         i = int(np.clip(np.floor((ex - x0) / sx), 0, ncx - 1))
         j = int(np.clip(np.floor((ey - y0) / sy), 0, ncy - 1))
-        top = float(self.top[max(j - 1, 0): j + 2, max(i - 1, 0): i + 2].max())
-        margin = 1e-4 * (abs(top) + abs(self.bottom) + 1.0)
+        top = float(self.top[max(j - rj, 0): j + rj + 1, max(i - ri, 0): i + ri + 1].max())
+        margin = 1e-4 * (abs(top) + abs(self.bottom) + 1.0) + reach
         return self.bottom - margin <= ez <= top + margin
+
+    def near_cuts(self, eye, view, near: float) -> bool:
+        """Whether the near clipping plane (at distance ``near`` along ``view`` from ``eye``) may cut the region
+        under the mesh where the view sees it: some of the region's box lies closer than ``near`` and the eye
+        is within reach of the near plane's rectangle (4 ``near``: conservative for view angles up to 120
+        degrees) of the region. A clipped front face would hand its rays to a later face, past the surface
+        between them; such frames use the full walk from the eye instead.
+
+        >>> from splinevis.terrain.model import TerrainSpline
+        >>> m = lifted_mesh(TerrainSpline.from_heights(np.zeros((5, 5)), "C1"), 1)
+        >>> m.near_cuts((2.0, 2.0, 0.05), (0.0, 1.0, 0.0), 0.1), m.near_cuts((2.0, -9.0, 5.0), (0.0, 1.0, 0.0), 0.1)
+        (True, False)
+        """
+        x0, x1, y0, y1 = self.extent
+        corners = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (self.bottom, float(self.top.max()))])
+        depth = (corners - np.asarray(eye, dtype=np.float64)) @ np.asarray(view, dtype=np.float64)
+        return bool(depth.min() < near) and self.eye_inside(eye, reach=4.0 * near)
 
 
 def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:

@@ -210,13 +210,16 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
         # the repository's glsl/ first when the package runs from a source tree (a worktree whose editable
         # install points elsewhere); in an installed package the folder does not exist and is skipped
         src = Path(__file__).resolve().parents[2] / "glsl"
-        inside = lambda eye, parallel: not parallel and mesh.eye_inside(eye)
+        # the eye (possibly) inside the region under the mesh, or the near plane cutting it where it is seen
+        inside = lambda eye, view, parallel, near: ((not parallel and mesh.eye_inside(eye))
+                                                    or mesh.near_cuts(eye, view, near))
         mesh_options = dict(attributes={"sv_mesh_cell": mesh.cells}, cull_front=False,
-                            defines_per_frame=lambda eye, view, parallel: (
-                                {"SV_TERRAIN_MESH_INSIDE": True} if inside(eye, parallel) else {}),
+                            defines_per_frame=lambda eye, view, parallel, near: (
+                                {"SV_TERRAIN_MESH_INSIDE": True} if inside(eye, view, parallel, near) else {}),
                             # the fragments of the faces the shader discards are not drawn at all (llvmpipe: the
                             # discarded back faces cost a third of the frame); the shader's test stays the rule
-                            cull_per_frame=lambda eye, view, parallel: "front" if inside(eye, parallel) else "back",
+                            cull_per_frame=lambda eye, view, parallel, near: (
+                                "front" if inside(eye, view, parallel, near) else "back"),
                             glsl_roots=(src,) if (src / "lib" / "terrain" / "mesh_guided.glsl").is_file() else ())
         extra_defines = {**extra_defines, "SV_TERRAIN_MESH": True}
         extra_uniforms = {**extra_uniforms, "sv_mesh_steps": check_degree(mesh_steps, "mesh_steps", low=0, high=256),
