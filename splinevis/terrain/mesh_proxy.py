@@ -66,9 +66,9 @@ What does not, or is not built:
   :data:`MAX_MESH_CELLS` cells get one square per block of B x B cells (:func:`mesh_block`), lifted by the
   block's bound (the smaller of the Hessian bound, for the C1 schemes, and the block's coefficient range), whatever
   the view.
-* The near clipping plane: a front face of R in front of the near plane is clipped, and a pixel whose surface
-  hit lies beyond the near plane then shows a later front face or nothing. The CPU test does not know the near
-  distance; scenes whose near plane cuts R in front of visible surface need the box proxy.
+* The near clipping plane is handled conservatively (:meth:`LiftedMesh.near_cuts`): a frame whose near plane may
+  cut R where it is seen runs the eye-inside build, as slow as the box. The test assumes view angles up to 120
+  degrees; it is not exercised by a hard case.
 * Overdraw: every front face along a ray runs the trace (gl_FragDepth is written, so there is no early depth
   test).
 * No debug builds (``debug`` is refused with ``proxy="mesh"``); no frustum culling of the mesh.
