@@ -400,8 +400,8 @@ def choose(program: str, model, view: View, max_error_px: float, style=None, *,
     >>> [(c.renderer, c.level) for c in (choose("terrain", t, v, e) for e in (2.0, 0.2, 0.02))]
     [('mesh', 1), ('mesh', 3), ('mesh', 12)]
     >>> c = choose("terrain", t, v, 0.02, triangle_cap=50_000)  # k = 12 has 73,728 triangles
-    >>> c.renderer, c.meets, [str(o) for o in c.options[-2:]]
-    ('raycast', True, ['mesh k=12: over the cap of 50,000 triangles', 'raycast 0.0177 px (estimate)'])
+    >>> c.renderer, c.meets, [str(o) for o in c.options[-3:]]  # the exact renderers: the cheaper one
+    ('mesh_guided', True, ['mesh k=12: over the cap of 50,000 triangles', 'mesh_guided 0.0177 px (estimate)', 'raycast 0.0177 px (estimate)'])
     """
     from .effects import Style
 

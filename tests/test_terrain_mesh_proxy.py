@@ -2,7 +2,7 @@
 the lifted mesh lies above the spline, the default program is unchanged, the eye-inside build is compiled only
 while the eye may be inside, and on the GPU a selection of the terrain's hard cases (those the tracing found
 hardest while it was built: grazing, flat, underside, C0 cliffs) agrees with the float64 twin as the box proxy's
-ray cast does, also with a mesh over blocks of cells. All 44 hard cases agree (run them with splinevis.programs:
+ray cast does (7 of them here), also with a mesh over blocks of cells. All 44 hard cases agree (run them with splinevis.programs:
 see the module docstring of splinevis.terrain.mesh_proxy)."""
 
 import dataclasses
@@ -57,8 +57,8 @@ def test_default_program_is_the_box():
         terrain_program(t, proxy="sphere")
 
 
-MESH_CASES = ["oblique", "grazing-1-degree", "underside", "camera-inside-box", "flat", "parallel-top-view",
-              "cliff-linear-oblique", "cliff-C0-oblique", "crater-C0-overview", "crater-C1-overview"]
+MESH_CASES = ["grazing-1-degree", "underside", "camera-inside-box", "flat", "cliff-linear-oblique", "cliff-C0-oblique",
+              "crater-C0-overview"]
 
 
 def test_eye_inside_build_only_while_the_eye_may_be_inside():

@@ -52,7 +52,7 @@ What works, measured (llvmpipe, 2 cores):
   4 x 4 cells; the other 43 also with the cap lowered to 300 squares, blocks of up to 8 x 8 cells) pass
   :func:`splinevis.analysis.agreement.agreement_failures` exactly as the box program does, at
   ``mesh_samples`` 1 and 32 steps (``python -c`` over ``splinevis.programs.get("terrain").hard_cases()`` with
-  ``program_options={"proxy": "mesh"}``; tests/test_terrain_mesh_proxy.py runs the 10 hardest). The tracing's
+  ``program_options={"proxy": "mesh"}``; tests/test_terrain_mesh_proxy.py runs 7 of the hardest). The tracing's
   twin finds the reference's first root to 1e-8 on 3,000 rays per scheme over a crater and a cliff
   (tests/test_terrain_trace.py).
 * Speed (benchmarks/bench_mesh_guided.py, full-screen C1 frame, 800 x 600): 2.5 to 4x faster than the box
