@@ -108,6 +108,7 @@ def view_bricks(store, isovalue, box=None, *, renderer=None) -> np.ndarray:
     (16, [1], 1)
     """
     from .render import camera_planes
+    from .view import _keep
 
     store = _open(store)
     iso = float(isovalue)
@@ -117,25 +118,21 @@ def view_bricks(store, isovalue, box=None, *, renderer=None) -> np.ndarray:
     ok = (lo <= iso) & (iso <= hi)
     idx = np.argwhere(ok).astype(np.int64)
     boxes = _brick_boxes(store, idx)
-    keep = np.ones(len(idx), dtype=bool)
+    world, planes = None, None
     if isinstance(box, str):
         if box != "all":
             raise ValueError(f"box must be a world box (xmin, xmax, ymin, ymax, zmin, zmax), 'all' or None (the "
                              f"camera's view), got {box!r}.")
     elif box is not None:
-        b = tuple(float(v) for v in box)
-        if len(b) != 6:
-            raise ValueError(f"box must be (xmin, xmax, ymin, ymax, zmin, zmax), got {len(b)} numbers.")
-        for ax in range(3):
-            keep &= (boxes[:, 2 * ax] <= b[2 * ax + 1]) & (boxes[:, 2 * ax + 1] >= b[2 * ax])
+        world = tuple(float(v) for v in box)
+        if len(world) != 6:
+            raise ValueError(f"box must be (xmin, xmax, ymin, ymax, zmin, zmax), got {len(world)} numbers.")
     elif renderer is None:
         raise ValueError("give a world box, 'all' or a renderer whose camera defines the view.")
     else:
-        for a, bb, c, d in camera_planes(renderer):  # the box's corner farthest inside each plane
-            px = np.where(a >= 0, boxes[:, 1], boxes[:, 0])
-            py = np.where(bb >= 0, boxes[:, 3], boxes[:, 2])
-            pz = np.where(c >= 0, boxes[:, 5], boxes[:, 4])
-            keep &= a * px + bb * py + c * pz + d >= 0
+        planes = camera_planes(renderer)
+    # the terrain tiles' test: a box meets the world box and lies not wholly outside any plane
+    keep = _keep(boxes[:, :4], boxes[:, 4], boxes[:, 5], world, planes)
     return np.ascontiguousarray(idx[keep])
 
 
