@@ -81,15 +81,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..bb import simplex as _simplex
+from .model import _DLAM_DU as _DU  # d(lambda)/du, d(lambda)/dv of T0 = (1 - u, u - v, v), T1 = (1 - v, u, v - u)
+from .model import _DLAM_DV as _DV
 
 __all__ = ["triangle_hessian_bounds", "trace_bounds", "mesh_block", "C1_SCHEMES", "second_derivative_bounds", "gradient_bounds", "cell_lifts", "lifted_mesh", "mesh_above", "LiftedMesh", "MAX_MESH_CELLS"]
 
 #: Most squares of the mesh proxy: a grid with more cells gets one square per block of cells (:func:`mesh_block`).
 MAX_MESH_CELLS = 512 * 512
-
-# d(lambda)/du, d(lambda)/dv of T0 = (1 - u, u - v, v) and T1 = (1 - v, u, v - u)
-_DU = np.array([[-1.0, 1.0, 0.0], [0.0, 1.0, -1.0]])
-_DV = np.array([[0.0, -1.0, 1.0], [-1.0, 0.0, 1.0]])
 
 
 def triangle_hessian_bounds(coefficients) -> np.ndarray:
@@ -367,14 +365,7 @@ def lifted_mesh(terrain, k: int = 2) -> LiftedMesh:
     a = gu[ci] + (gu[ci + 1] - gu[ci]) * (np.arange(nu) - ci * kk) / kk
     b = gv[cj] + (gv[cj + 1] - gv[cj]) * (np.arange(nv) - cj * kk) / kk
     U, V = np.meshgrid(a, b)  # (nv, nu)
-    i = np.clip(np.floor(U).astype(np.int64), 0, ncx - 1)
-    j = np.clip(np.floor(V).astype(np.int64), 0, ncy - 1)
-    lu, lv = U - i, V - j
-    tri = (lv > lu).astype(np.int64)
-    from .model import cell_barycentric
-
-    lam = cell_barycentric(lu, lv, tri)
-    z = _simplex.de_casteljau(terrain.coefficients[j, i, tri], lam, d=2)
+    z = terrain.height_at_index(U, V)
     # vertex lift: the largest lift of the squares touching the vertex
     pad = np.pad(lifts, 1, mode="edge")
     touch = np.maximum(np.maximum(pad[:-1, :-1], pad[1:, :-1]), np.maximum(pad[:-1, 1:], pad[1:, 1:]))  # (ngy+1, ngx+1)

@@ -264,10 +264,20 @@ class TerrainSpline:
         >>> t.evaluate(np.array([2.5, 7.0]), np.array([1.5, 1.0])).round(12)  # the second point lies outside
         array([ 4.75, 48.  ])
         """
-        u, v = self.to_index(x, y)
-        i, j, tri, lu, lv = self._locate(u, v)
+        return self.z_ref + self.height_at_index(*self.to_index(x, y))
+
+    def height_at_index(self, u, v) -> np.ndarray:
+        """Height relative to ``z_ref`` at index coordinates (u, v) (spline cells; the cell and triangle by
+        floor and u = v, clamped to the grid as :meth:`evaluate`).
+
+        >>> y, x = np.mgrid[0:5, 0:6].astype(float)
+        >>> t = TerrainSpline.from_heights(x * x - y, "C1")
+        >>> round(float(t.height_at_index(2.5, 1.5) + t.z_ref), 12)
+        4.75
+        """
+        i, j, tri, lu, lv = self._locate(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
         lam = cell_barycentric(lu, lv, tri)
-        return self.z_ref + _simplex.de_casteljau(self._c[j, i, tri], lam, d=2)
+        return _simplex.de_casteljau(self._c[j, i, tri], lam, d=2)
 
     def gradient(self, x, y) -> np.ndarray:
         """(…, 2) physical gradient (ds/dx, ds/dy).

@@ -20,9 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..bb import simplex as _simplex
 from .mesh_proxy import second_derivative_bounds
-from .model import cell_barycentric
 
 __all__ = ["chord_bounds", "cell_boxes", "sampled_mesh", "mesh_triangles"]
 
@@ -93,11 +91,7 @@ def sampled_mesh(terrain, k: int):
     ncy, ncx = terrain.shape
     nu, nv = k * ncx + 1, k * ncy + 1
     U, V = np.meshgrid(np.arange(nu) / k, np.arange(nv) / k)  # (nv, nu)
-    i = np.clip(np.floor(U).astype(np.int64), 0, ncx - 1)
-    j = np.clip(np.floor(V).astype(np.int64), 0, ncy - 1)
-    lu, lv = U - i, V - j
-    tri = (lv > lu).astype(np.int64)
-    z = terrain.z_ref + _simplex.de_casteljau(terrain.coefficients[j, i, tri], cell_barycentric(lu, lv, tri), d=2)
+    z = terrain.z_ref + terrain.height_at_index(U, V)
     sx, sy = terrain.cell_spacing
     x = terrain.origin[0] + U * sx
     y = terrain.origin[1] + V * sy

@@ -32,13 +32,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..bb import simplex as _simplex
-from .model import TerrainSpline, cell_barycentric
+# _DU, _DV: barycentric directions of index u and v on T0 = (1 - u, u - v, v) and T1 = (1 - v, u, v - u)
+from .model import _DLAM_DU as _DU, _DLAM_DV as _DV, TerrainSpline, cell_barycentric
 
 __all__ = ["TraceResult", "trace_first_root"]
-
-# barycentric directions of index u and v on T0 = (1 - u, u - v, v) and T1 = (1 - v, u, v - u)
-_DU = np.array([[-1.0, 1.0, 0.0], [0.0, 1.0, -1.0]])
-_DV = np.array([[0.0, -1.0, 1.0], [-1.0, 0.0, 1.0]])
 
 
 @dataclass
