@@ -96,6 +96,13 @@ float sv_triangle_hit(float b[15], int tri, vec3 o, vec3 d, float ta, float tb, 
     return s == SV_NO_HIT ? SV_NO_HIT : ta + s;
 }
 
+// Where the index-space ray P0 + t D leaves the rectangle [lo, hi] across x and across y: (tx, ty), 3e38 for an
+// axis the ray runs along. Cells, hierarchy blocks and the mesh-guided tracing's pieces all step by it.
+vec2 sv_rect_exit(vec3 P0, vec3 D, vec2 lo, vec2 hi) {
+    return vec2(abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? hi.x : lo.x) - P0.x) / D.x,
+                abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? hi.y : lo.y) - P0.y) / D.y);
+}
+
 // The index-space ray P0 + t D from tmin clipped to the terrain's box (cells x height range): [t, t_end], false
 // when the ray misses it.
 bool sv_clip_to_box(vec3 P0, vec3 D, float tmin, out float t, out float t_end) {
@@ -211,8 +218,9 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         float size = float(1 << L);
         vec2 lo = vec2(c) * size;
         vec2 hi = min(lo + vec2(size), sv_ncells);
-        float tx = abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? hi.x : lo.x) - P0.x) / D.x;
-        float ty = abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? hi.y : lo.y) - P0.y) / D.y;
+        vec2 txy = sv_rect_exit(P0, D, lo, hi);
+        float tx = txy.x;
+        float ty = txy.y;
         float tb = min(min(tx, ty), t_end);
         vec2 mm = sv_block_minmax(L, c);
         float za = P0.z + t * D.z;

@@ -83,9 +83,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         ivec2 bk = clamp(ivec2(floor(ahead / skip)), ivec2(0), nblocks);
         vec2 blo = vec2(bk) * skip;
         vec2 bhi = min(blo + vec2(skip), sv_ncells);
-        float bx = abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? bhi.x : blo.x) - P0.x) / D.x;
-        float by = abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? bhi.y : blo.y) - P0.y) / D.y;
-        float tbk = min(min(bx, by), t_end);
+        vec2 bxy = sv_rect_exit(P0, D, blo, bhi);
+        float tbk = min(min(bxy.x, bxy.y), t_end);
         vec2 mm = sv_block_minmax(sv_mesh_skip_level, bk);
         float za = P.z;
         float zb = P0.z + tbk * D.z;
@@ -141,11 +140,10 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         float h = 2.0 * sg / max(sqrt(max(sgp * sgp + 2.0 * K * sg, 0.0)) - sgp, 1e-30);
         // no further than the piece's border (the cell's edges and its diagonal u = v)
         vec2 cl = vec2(c);
-        float tx = abs(D.x) < 1e-30 ? 3.0e38 : ((D.x > 0.0 ? cl.x + 1.0 : cl.x) - P0.x) / D.x;
-        float ty = abs(D.y) < 1e-30 ? 3.0e38 : ((D.y > 0.0 ? cl.y + 1.0 : cl.y) - P0.y) / D.y;
+        vec2 cxy = sv_rect_exit(P0, D, cl, cl + vec2(1.0));
         float dw = D.y - D.x;
         float tdg = abs(dw) < 1e-30 ? 3.0e38 : ((P0.x - cl.x) - (P0.y - cl.y)) / dw;
-        float tb = min(tx, ty);
+        float tb = min(cxy.x, cxy.y);
         if (tdg > t) tb = min(tb, tdg);
         if (clear) tb = max(tb, tbk);
         bool cross = clear || t + h >= tb;
