@@ -36,10 +36,12 @@ def _cmd_selftest(args) -> int:
     report = run_selftest(args.out, cases=args.cases, seed=args.seed, progress=not args.quiet)
     rows = report["functions"] if "functions" in report else report
     failed = [r for r in _rows(rows) if not r.get("pass", False)]
-    print(f"selftest: {len(_rows(rows)) - len(failed)} of {len(_rows(rows))} functions within their bounds; "
+    print(f"selftest: {len(_rows(rows)) - len(failed)} of {len(_rows(rows))} functions pass (within their bounds; "
+          f"first_root rows: every case beyond the bound meets its derived expectation); "
           f"report in {Path(args.out) / 'selftest.json'}")
     for r in failed:
-        print(f"  FAILED {r.get('function', r.get('name'))}: max error {r.get('max_error')} > bound {r.get('bound')}")
+        print(f"  FAILED {r.get('function', r.get('name'))}: max error {r.get('max_err_eps')} eps > bound {r.get('bound_eps')}"
+              f"{'; unexplained ' + str(r['unexplained_total']) if 'unexplained_total' in r else ''}")
     cases = [(p, c, r) for p, rows in report.get("programs", {}).items() for c, r in rows.items()]
     bad = [(p, c, r) for p, c, r in cases if not r["pass"]]
     print(f"selftest: {len(cases) - len(bad)} of {len(cases)} program hard cases agree with their float64 twins")
