@@ -15,12 +15,15 @@ pytestmark = pytest.mark.gl
 
 
 def test_raycast_surface_and_mesh_occlude_each_other_both_ways():
+    # Which surface is in front, per pixel, GPU against the patch's float64 ray cast and the mesh's own rasterized
+    # depth: no pixel may disagree (measured: 0 of 21,751 here at 400 x 300; 0 of 55,654 at 640 x 480, the figure
+    # of `splinevis demo`). The patch's depths in this view: hard case 'oblique', every one within the derived bound.
     r = front_surface_agreement(*composite_scene((400, 300), style=UNLIT)[:2])
     sphere_in_front, patch_in_front = r["both_ways"]
     # The scene is built so that each surface hides the other over a sizeable area.
     assert sphere_in_front > 500 and patch_in_front > 500
     assert r["compared"] > 10_000
-    assert r["agreement"] >= 0.999, f"{r['disagree_count']} of {r['compared']} pixels disagree"
+    assert r["disagree_count"] == 0, f"{r['disagree_count']} of {r['compared']} pixels disagree"
 
 
 def _fragment_source(style):
@@ -148,3 +151,36 @@ def test_depth_buffer_before_any_render_renders_first():
     depth = pl.depth_buffer()
     pl.close()
     assert np.isfinite(depth).all() and depth.max() == 1.0 and 0.0 < depth.min() < 1.0
+
+
+def test_paper_newton_one_sided_pixels_are_silhouette_misses():
+    # The patch's hard cases with the bracketed root finder allow no one-sided pixel and no depth beyond the bound
+    # (splinevis.analytic.program.hard_cases). With the paper's 4-start Newton the GPU misses a few pixels at the
+    # patch's outline: their reference hit lies at an edge of the triangle (smallest barycentric coordinate < 0.01,
+    # about 3 pixel footprints here: neighbouring pixels differ by 0.003), i.e. the first root of the ray's
+    # restriction sits at the end of its parameter interval in the prism, where an iterate that steps just past
+    # it is rejected. Asserted: no leak, every depth within the bound, no GPU hit where the reference has none,
+    # every one-sided pixel a GPU miss on the reference's silhouette (a missing 8-neighbour) with its hit at a
+    # triangle edge; and the count measured on this machine's llvmpipe: 14 of 13,868 reference hits.
+    from scipy import ndimage
+
+    from splinevis import programs
+    from splinevis.analysis.agreement import agreement_failures, hard_case_agreement
+    from splinevis.gl.camera import pixel_rays
+
+    case = next(c for c in programs.get("analytic_patch").hard_cases() if c.name == "paper-newton")
+    r = hard_case_agreement(case)
+    assert agreement_failures(r, case) == [] and r["leaks"] == 0
+    assert (r["depth_error"] <= r["depth_bound"]).all()
+    ref_hit = np.isfinite(r["reference_depth"]) & (r["reference_depth"] >= 0) & (r["reference_depth"] <= 1)
+    gpu_hit = r["gpu_depth"] < 1.0
+    assert not (gpu_hit & ~ref_hit).any()  # never a hit where there is none
+    missed = ref_hit & ~gpu_hit
+    interior = ndimage.binary_erosion(ref_hit, structure=np.ones((3, 3)), border_value=0)
+    assert not (missed & interior).any()
+    model = case.model()
+    o, d = pixel_rays(r["matrix"], *case.window_size)
+    hits = model.raycast(o[ref_hit], d[ref_hit])
+    lam = hits.points[:, :2] @ model._m[:, :2].T + model._m[:, 2]  # barycentric coordinates in the triangle
+    assert np.all(lam.min(axis=1)[missed[ref_hit]] < 0.01)
+    assert int(missed.sum()) == r["hit_disagree"] == 14

@@ -97,18 +97,30 @@ def _reference(patch, origins, directions, tmin=0.0, *, method="reference", iter
 def hard_cases() -> list:
     """Views where a float32 ray cast of the patch is most likely to part from float64: the showcase's oblique
     view, rays grazing the patch 1 degree above the plane of its low edge, the camera below (the underside),
-    the camera inside the proxy prism, and the paper's root finder."""
+    the camera inside the proxy prism, and the paper's root finder.
+
+    With the default (bracketed) root finder every case must agree exactly: no pixel hit on one side only
+    (``max_disagree=0``) and every depth within the derived bound (``depth_fraction=1``). The paper's
+    4-start Newton keeps the default 0.1 % of one-sided pixels: it misses some silhouette pixels, where the ray
+    grazes the surface and the first root is nearly double (Newton converges linearly there and 8 float32
+    steps need not pass the residual test); tests/test_inject.py asserts that those are GPU misses on the
+    reference's silhouette only, and how many.
+
+    >>> [(c.name, c.max_disagree, c.depth_fraction) for c in hard_cases()][::4]
+    [('oblique', 0.0, 1.0), ('paper-newton', 0.001, 1.0)]
+    """
     demo = QuarticTrianglePatch.demo
     oblique = [(2.5, -3.3, 2.4), (0.05, -0.1, 0.05), (0, 0, 1)]
     size = (400, 300)
+    exact = dict(max_disagree=0.0, depth_fraction=1.0)
     return [
-        HardCase("oblique", demo, oblique, size, min_hits=10_000 / 120_000),
+        HardCase("oblique", demo, oblique, size, min_hits=10_000 / 120_000, **exact),
         HardCase("grazing-1-degree", demo, [(-3.0, -0.2, 0.05 + 3.0 * np.tan(np.radians(1.0))), (0.0, 0.0, 0.05),
-                                            (0, 0, 1)], size, min_hits=1_000 / 120_000),
-        HardCase("underside", demo, [(0.6, -2.2, -1.6), (0.05, -0.1, 0.05), (0, 0, 1)], (320, 240)),
+                                            (0, 0, 1)], size, min_hits=1_000 / 120_000, **exact),
+        HardCase("underside", demo, [(0.6, -2.2, -1.6), (0.05, -0.1, 0.05), (0, 0, 1)], (320, 240), **exact),
         HardCase("camera-inside-prism", demo, [(0.0, -0.2, 0.2), (0.5, 0.6, 0.0), (0, 0, 1)], (320, 240),
-                 clipping_range=(1e-3, 10.0)),
-        HardCase("paper-newton", demo, oblique, (320, 240), program_options={"roots": "paper"}),
+                 clipping_range=(1e-3, 10.0), **exact),
+        HardCase("paper-newton", demo, oblique, (320, 240), program_options={"roots": "paper"}, depth_fraction=1.0),
     ]
 
 
