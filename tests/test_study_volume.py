@@ -121,9 +121,19 @@ def test_cli_knows_the_volume_study(capsys):
     assert exc.value.code == 0
 
 
-def test_cubic_status_says_what_it_found():
+def test_cubic_status_says_what_it_found(monkeypatch):
+    # the cubic scheme is implemented: here it must be found
+    assert V.cubic_status() == (True, "cubic scheme available")
+    # and when it cannot be built, the note says so and why
+    import splinevis.volume.model as model
+
+    class Broken:
+        def __init__(self, *args, **kwargs):
+            raise NotImplementedError("no cubic here")
+
+    monkeypatch.setattr(model, "VolumeSpline", Broken)
     ok, note = V.cubic_status()
-    assert isinstance(ok, bool) and ("available" in note)
+    assert ok is False and note.startswith("cubic scheme NOT available (NotImplementedError: no cubic here)")
 
 
 @pytest.mark.gl

@@ -288,3 +288,13 @@ def test_translucent_isosurface_over_opaque_meshes():
     assert np.mean(err <= 3.0) >= 0.999, np.sort(err)[-5:]
     hidden = ~surface
     assert np.abs(C - B)[hidden].max() <= 3.0  # where a mesh occludes the surface (or it is absent) nothing changes
+
+
+def test_cubic_with_the_coefficient_table_matches_its_twin():
+    # The hard cases (splinevis.volume.hard_cases) cover the cubic scheme with the 'data' and 'determining'
+    # encodings; this is the third: every BB coefficient in a table. Same sphere, camera, window and limits.
+    case = HardCase("cubic-sphere-blocks-table", lambda: Isosurface(VolumeSpline(sphere_grid(), "cubic"), 0.7), CAM,
+                    (160, 120), program_options={"encoding": "coefficients"}, min_hits=500 / 19200)
+    r = hard_case_agreement(case)
+    assert agreement_failures(r, case) == []
+    assert r["leaks"] == 0 and r["hit_disagree"] == 0 and (r["depth_error"] <= r["depth_bound"]).all()  # measured
