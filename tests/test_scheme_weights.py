@@ -39,10 +39,23 @@ def _bits(a):
     return np.ascontiguousarray(a, dtype=np.float64).view(np.uint64)
 
 
-def test_stored_c1_terrain_weights_are_the_derivation_to_the_bit(derived):
+def _c1_forward_bound():
+    """Forward error bound of the least-norm solve of the C1 system, ``sqrt(N) u kappa max|W|``: the
+    first-order perturbation bound of a consistent least-squares problem (residual 0), ``|dx| / |x| <= p u
+    kappa`` with kappa = s_max / s_rank of the system, and p = sqrt(N) (N unknowns) for the backward error of
+    an SVD-based solver. The last bits of the solution depend on the BLAS kernels (an AVX-512 machine
+    differs from an AVX2 one by ~8 units in the last place), so the stored floats are compared within this."""
+    A, _, _ = c1_scheme.c1_system()
+    rank = c1_scheme._c1_solution()[1]["rank"]
+    s = np.linalg.svd(A, compute_uv=False)
+    stored = np.array(C1_FLOATS, dtype=np.float64)
+    return np.sqrt(A.shape[1]) * np.finfo(float).eps / 2 * (s[0] / s[rank - 1]) * np.abs(stored).max()
+
+
+def test_stored_c1_terrain_weights_are_the_derivation(derived):
     stored = np.array(C1_FLOATS, dtype=np.float64)
     assert stored.shape == (len(c1_scheme.C1_STENCIL), 30)
-    assert np.array_equal(_bits(stored), _bits(derived["C1"]))
+    assert np.abs(stored - derived["C1"]).max() <= _c1_forward_bound()
     # the scheme's window holds exactly these rows at the stencil's offsets, zeros elsewhere
     st = c1_scheme._c1()
     offs = [(st.x0 + b, st.y0 + a) for a in range(st.kh) for b in range(st.kw)]
@@ -69,7 +82,12 @@ def test_stored_volume_weights_are_exact_fractions_equal_to_the_derivation(deriv
 
 
 def test_generated_weight_modules_are_current(derived):
-    for rel, text in _generator().generate(derived).items():
+    # the C1 floats are the derivation within its forward bound (test above); the file must be the generator's
+    # text of the stored floats, the volume fractions the derivation's exactly
+    tables = dict(derived)
+    assert np.abs(np.array(C1_FLOATS) - derived["C1"]).max() <= _c1_forward_bound()
+    tables["C1"] = np.array(C1_FLOATS, dtype=np.float64)
+    for rel, text in _generator().generate(tables).items():
         assert (ROOT / rel).read_text() == text, f"run python tools/gen_scheme_weights.py ({rel} is stale)"
 
 

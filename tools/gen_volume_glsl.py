@@ -35,15 +35,25 @@ def _f(x: float) -> str:
     return r if ("." in r or "e" in r) else r + ".0"
 
 
+def _exact(x: float) -> float:
+    """The float64 of the fraction with denominator <= 4096 within 1e-12 of ``x``, else ``x``: the weights
+    are rationals that float64 solves reproduce only up to roundoff whose last bits depend on the BLAS
+    kernels (AVX2 and AVX-512 machines differ), so the generated text is the same on every machine."""
+    from fractions import Fraction
+
+    q = float(Fraction(float(x)).limit_denominator(4096))
+    return q if abs(q - x) < 1e-12 else float(x)
+
+
 def _weighted_sum(w: np.ndarray, var: str) -> str:
     """GLSL for sum_k w[k] var[k] with the terms grouped by weight (largest magnitude first); weights are
-    rounded to 15 decimals for grouping, so exact rationals from float64 solves group together."""
+    snapped to the exact rationals they are (:func:`_exact`), so they group together."""
     groups: dict = {}
     value: dict = {}
     for k in np.nonzero(np.abs(w) > 1e-14)[0]:
-        key = round(float(w[k]), 15)
+        key = _exact(float(w[k]))
         groups.setdefault(key, []).append(int(k))
-        value.setdefault(key, float(w[k]))  # printed at full precision
+        value.setdefault(key, key)
     parts = []
     for key, ks in sorted(groups.items(), key=lambda kv: -abs(kv[0])):
         ssum = " + ".join(f"{var}[{k}]" for k in ks)
