@@ -239,7 +239,8 @@ class Plotter(pv.Plotter):
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
-                       max_error_px: float | None = None, **options):
+                       max_error_px: float | None = None, prefilter: str = "none", padding: str = "linear",
+                       **options):
         """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data [Kalbe2008].
 
         ``max_error_px``: draw it the cheapest way whose screen-space error stays below that many pixels for
@@ -250,7 +251,11 @@ class Plotter(pv.Plotter):
 
         ``volume`` is a :class:`~splinevis.volume.VolumeSpline`, a :class:`~splinevis.io.VolumeGrid`, or
         anything :func:`splinevis.io.read_volume` reads (3-D array, pyvista ImageData, .vti/.nrrd/.mha/...
-        file); ``scheme`` ``"quadratic"`` or ``"cubic"`` (ignored for a VolumeSpline). ``culling``: hierarchical
+        file); ``scheme`` ``"quadratic"`` or ``"cubic"``, ``prefilter`` ``"none"`` (the paper's quasi-interpolant),
+        ``"local"`` (reproduces quadratics: values of order 3) or ``"interpolate"`` (cubic: the spline
+        interpolates the samples) and ``padding`` ``"linear"``, ``"quadratic"`` or ``"cubic"`` (order 2 gradients up
+        to the boundary) choose the spline (:class:`~splinevis.volume.VolumeSpline`; all ignored for a
+        VolumeSpline). ``culling``: hierarchical
         view-frustum culling of the proxies by the octree before every frame (``actor.culler``). Program options
         (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
         :meth:`add_spline`). An isovalue outside the data's range (an empty isosurface) raises ValueError
@@ -271,10 +276,10 @@ class Plotter(pv.Plotter):
         if max_error_px is not None:
             from .choice import add_by_accuracy
 
-            return add_by_accuracy(self, "isosurface", (volume, isovalue, scheme), read_options, style,
+            return add_by_accuracy(self, "isosurface", (volume, isovalue, scheme, prefilter, padding), read_options, style,
                                    dict(options, newton_iterations=newton_iterations), max_error_px,
                                    style_from=_style_from, add_options={"culling": culling})
-        return self._add_from("isosurface", (volume, isovalue, scheme), read_options, style,
+        return self._add_from("isosurface", (volume, isovalue, scheme, prefilter, padding), read_options, style,
                               dict(options, newton_iterations=newton_iterations), {"culling": culling})
 
     def _add_from(self, program_name, args, read_options, style, options, add_options=None):

@@ -99,6 +99,14 @@ class VolumeSpline:
     scheme : {"quadratic", "cubic"}
         ``"quadratic"``: quadratic super spline; ``"cubic"``: cubic C1 quasi-interpolant
         (docs/volume-schemes.md).
+    prefilter : {"none", "local", "interpolate"}
+        The data the scheme reads (:mod:`splinevis.volume.prefilter`): the samples (``"none"``, [Kalbe2008]),
+        the local correction that makes the spline reproduce quadratics (``"local"``: values of order 3), or
+        the data whose spline interpolates the samples (``"interpolate"``, cubic only, a global solve).
+    padding : {"linear", "quadratic", "cubic"}
+        Extrapolation of the data by one layer beyond the boundary
+        (:data:`splinevis.volume.stencil.PADDINGS`); ``"linear"`` is the paper's, the others keep order 2
+        for gradients up to the boundary.
     **read_options
         Passed to ``read_volume`` (spacing, origin, scalars, ...).
 
@@ -110,9 +118,13 @@ class VolumeSpline:
     >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic")
     >>> float(s.evaluate([[3.25, 2.5, 1.0]])[0])  # linear data are reproduced
     11.25
+    >>> q = VolumeSpline(x ** 2, "quadratic", prefilter="local", padding="quadratic")  # x^2 exact, boundary too
+    >>> float(q.evaluate([[-0.5, 0.0, 0.0]])[0]), float(VolumeSpline(x ** 2).evaluate([[-0.5, 0.0, 0.0]])[0])
+    (0.25, -0.5)
     """
 
-    def __init__(self, volume, scheme: str = "quadratic", **read_options):
+    def __init__(self, volume, scheme: str = "quadratic", *, prefilter: str = "none", padding: str = "linear",
+                 **read_options):
         if scheme not in SCHEME_DEGREE:
             raise ValueError(f"scheme must be one of {sorted(SCHEME_DEGREE)}, got {scheme!r}.")
         if isinstance(volume, VolumeGrid):
@@ -131,8 +143,17 @@ class VolumeSpline:
         self.degree = SCHEME_DEGREE[scheme]
         self.weights = tet_weights(scheme)
         self.ncoef = self.weights.shape[1]
+        self.prefilter, self.padding = prefilter, padding
         t0 = time.perf_counter()
-        self.padded = _schemes._pad(grid.values)  # the grid is validated already
+        if prefilter == "none" and padding == "linear":
+            self.padded = _schemes._pad(grid.values)  # the grid is validated already
+        else:
+            from .prefilter import padded_data
+
+            try:
+                self.padded = padded_data(grid.values, scheme, prefilter, padding)
+            except ValueError as e:
+                raise ValueError(f"{grid.source}: {e}") from None
         self._octree = None
         self.setup_seconds = time.perf_counter() - t0
 
@@ -158,6 +179,7 @@ class VolumeSpline:
             raise ValueError("padded data must be finite.")
         self = cls.__new__(cls)
         self.grid = VolumeGrid(P[1:-1, 1:-1, 1:-1], spacing=tuple(spacing), origin=tuple(origin), source=source)
+        self.prefilter, self.padding = "none", "given"
         self.scheme = scheme
         self.degree = SCHEME_DEGREE[scheme]
         self.weights = tet_weights(scheme)
@@ -433,8 +455,10 @@ class VolumeSpline:
 
     def __repr__(self):
         nz, ny, nx = self.shape
+        extra = "" if (self.prefilter, self.padding) in (("none", "linear"), ("none", "given")) else \
+            f", prefilter={self.prefilter!r}, padding={self.padding!r}"
         return (f"VolumeSpline({self.scheme}, {nx}x{ny}x{nz} cubes, spacing={self.grid.spacing}, origin={self.grid.origin}, "
-                f"source={self.grid.source!r})")
+                f"source={self.grid.source!r}{extra})")
 
 
 def _second_blossom(coef: np.ndarray) -> np.ndarray:

@@ -248,10 +248,11 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
                                         float(np.abs(b).max()), sp.degree)
 
 
-def _model_from(volume, isovalue, scheme="quadratic", **read_options) -> Isosurface:
+def _model_from(volume, isovalue, scheme="quadratic", prefilter="none", padding="linear", **read_options) -> Isosurface:
     """An :class:`Isosurface` of a VolumeSpline, a VolumeGrid or anything :func:`splinevis.io.read_volume`
-    reads (``scheme`` and ``read_options`` are ignored for a VolumeSpline)."""
-    spline = volume if isinstance(volume, VolumeSpline) else VolumeSpline(volume, scheme, **read_options)
+    reads (``scheme``, ``prefilter``, ``padding`` and ``read_options`` are ignored for a VolumeSpline)."""
+    spline = volume if isinstance(volume, VolumeSpline) else VolumeSpline(volume, scheme, prefilter=prefilter,
+                                                                           padding=padding, **read_options)
     surface = Isosurface(spline, isovalue)
     check_isovalue_in_range(surface)
     return surface
