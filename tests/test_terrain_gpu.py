@@ -19,6 +19,22 @@ def franke_c2c():
     return franke_terrain()
 
 
+@pytest.mark.parametrize("scheme", ["C2-interp"])
+def test_c2_and_its_interpolating_variant_agree_with_the_twin(scheme):
+    # C2-interp is the C2 program unchanged on prefiltered heights: the crater hard case of C2, oblique view
+    # (the hard cases' own agreement criteria), drawn with either scheme's coefficients
+    import dataclasses
+    import functools
+
+    from splinevis.terrain.hard_cases import _relief
+
+    case = next(c for c in programs.get("terrain").hard_cases() if c.name == "crater-C2-oblique")
+    case = dataclasses.replace(case, name=f"crater-{scheme}-oblique", model=functools.partial(_relief, "crater", scheme),
+                               window_size=(200, 150))
+    r = hard_case_agreement(case)
+    assert agreement_failures(r, case) == []
+
+
 def test_huge_offsets_keep_precision():
     # UTM-sized origin and heights 2000 +- 0.5 (the terrain's hard case "utm-coordinates", which
     # tests/test_program_hard_cases.py checks against the bound): the depth agreement is as good as near the

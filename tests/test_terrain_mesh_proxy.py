@@ -18,7 +18,7 @@ from splinevis.terrain.model import TerrainSpline
 from splinevis.terrain.program import terrain_program
 
 
-@pytest.mark.parametrize("scheme", ["linear", "C0", "C1", "C2-cubic"])
+@pytest.mark.parametrize("scheme", ["linear", "C0", "C1", "C2-cubic", "C2-interp"])
 @pytest.mark.parametrize("k", [1, 3])
 def test_lifted_mesh_lies_above_the_spline(scheme, k):
     t = TerrainSpline.from_heights(high_relief("crater", 33), scheme, spacing=(1.0, 1.0))

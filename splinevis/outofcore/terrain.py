@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..terrain.engine import _apply_padded, _pad_cubic
-from ..terrain.schemes import _BUILDERS, _MIN_SIZE, SCHEMES
+from ..terrain.schemes import _BUILDERS, _MIN_SIZE, SCHEMES, STENCIL_SCHEMES
 from .halo import _check_tile, _pad_axis_lazy, _window_map, as_dask_array, tile_chunks
 
 __all__ = ["terrain_halo", "terrain_coefficients_dask", "terrain_input_chunks"]
@@ -43,6 +43,11 @@ def terrain_halo(scheme):
     """
     if scheme not in SCHEMES:
         raise ValueError(f"scheme {scheme!r} is not known; choose one of {', '.join(SCHEMES)}.")
+    if scheme not in STENCIL_SCHEMES:
+        raise ValueError(f"scheme {scheme} is not supported out of core: its prefilter solves one linear system over the "
+                         f"whole grid (every coefficient depends on every height), which tiles cannot do. Use "
+                         f"'C2-cubic', the same C2 box spline with a local cubic-exact prefilter (also order 4), or "
+                         f"build {scheme} in memory (TerrainSpline.from_heights) on a grid that fits.")
     st = _BUILDERS[scheme]()
     lo_x, hi_x, _, _ = st.pads()
     halo = st.kw - st.step

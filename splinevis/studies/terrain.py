@@ -30,7 +30,7 @@ import numpy as np
 
 from .report import error_summary, md_table, paper_columns, progress_bar, pyplot, save_figure, timed, write_json
 
-__all__ = ["run_terrain_study", "accuracy_table", "PAPER_TABLE_I"]
+__all__ = ["run_terrain_study", "accuracy_table", "accuracy_orders", "write_accuracy", "PAPER_TABLE_I"]
 
 WINDOW = (800, 600)
 CAMERA = [(-0.35, -0.75, 1.55), (0.5, 0.48, 0.25), (0.0, 0.0, 1.0)]
@@ -62,8 +62,19 @@ def franke_terrain(n: int, scheme: str):
     return TerrainSpline.from_heights(z, scheme, spacing=(1.0 / (n - 1), 1.0 / (n - 1)), origin=(0.0, 0.0))
 
 
-def accuracy_table(sizes=(13, 25, 49, 97), schemes=("linear", "C0", "C1", "C2", "C2-cubic"), sites=100_000, seed=0):
-    """Relative RMS and max error (relative to the max data amplitude) over random sites in [0,1]^2.
+ACCURACY_SCHEMES = ("linear", "C0", "C1", "C2", "C2-cubic", "C2-interp")
+
+#: The inner region of the accuracy table: sites at least this far (in [0, 1] units) from the boundary.
+INNER_MARGIN = 0.25
+
+
+def accuracy_table(sizes=(13, 25, 49, 97), schemes=ACCURACY_SCHEMES, sites=100_000, seed=0):
+    """Relative errors of values and gradients over random sites in [0,1]^2, in the full square and in the inner
+    square ``[0.25, 0.75]^2``: values relative to the max data amplitude, gradients (physical units) relative to
+    the largest gradient of Franke's function at the sites.
+
+    Keys per row: ``rms_rel``, ``max_rel`` (values, full), ``inner_max_rel`` (values, inner), ``grad_max_rel``,
+    ``grad_rms_rel`` (gradients, full), ``inner_grad_max_rel`` (gradients, inner), and the paper's numbers.
 
     Examples
     --------
@@ -76,23 +87,65 @@ def accuracy_table(sizes=(13, 25, 49, 97), schemes=("linear", "C0", "C1", "C2", 
     >>> rows[1]["rms_rel"] < rows[0]["rms_rel"]  # the C1 quartic beats the linear mesh
     True
     """
-    franke, _ = _franke()
+    franke, franke_gradient = _franke()
     rng = np.random.default_rng(seed)
     xy = rng.random((sites, 2))
     exact = franke(xy[:, 0], xy[:, 1])
+    exact_g = franke_gradient(xy[:, 0], xy[:, 1])
+    inner = np.all((xy >= INNER_MARGIN) & (xy <= 1.0 - INNER_MARGIN), axis=1)
+    gamp = float(np.linalg.norm(exact_g, axis=-1).max())
     rows = []
     for n in sizes:
         amp = float(np.abs(franke(*np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n)))).max())
         for scheme in schemes:
             terrain = franke_terrain(n, scheme)
             err = terrain.evaluate(xy[:, 0], xy[:, 1]) - exact
+            gerr = np.linalg.norm(terrain.gradient(xy[:, 0], xy[:, 1]) - exact_g, axis=-1)
             paper = PAPER_TABLE_I.get((scheme, (n - 1) ** 2))  # the paper counts 144 = 12^2 for 13x13 samples
             rows.append({
-                "scheme": scheme, "grid": f"{n}x{n}", "data_points": n * n, "patches": terrain.num_patches,
+                "scheme": scheme, "grid": f"{n}x{n}", "n": n, "data_points": n * n, "patches": terrain.num_patches,
                 "rms_rel": float(np.sqrt(np.mean(err ** 2)) / amp), "max_rel": float(np.abs(err).max() / amp),
+                "inner_max_rel": float(np.abs(err[inner]).max() / amp),
+                "grad_rms_rel": float(np.sqrt(np.mean(gerr ** 2)) / gamp), "grad_max_rel": float(gerr.max() / gamp),
+                "inner_grad_max_rel": float(gerr[inner].max() / gamp),
                 "paper_rms_rel": paper[0] if paper else None, "paper_max_rel": paper[1] if paper else None,
             })
     return rows
+
+
+_ORDER_KEYS = ("max_rel", "inner_max_rel", "grad_max_rel", "inner_grad_max_rel")
+
+
+def accuracy_orders(rows):
+    """Observed orders ``log2(e_n / e_2n')`` between consecutive sizes of :func:`accuracy_table` (sizes
+    ``2^k + 1``, so h halves), and each scheme's error ratios to ``linear`` and (when in the rows) to ``C2`` at
+    the same size.
+
+    Returns rows ``{"scheme", "grids", "order_max_rel", "order_inner_max_rel", ...}`` and
+    ``{"scheme", "grid", "vs_linear_max_rel", ..., "vs_C2_max_rel", ...}``.
+
+    Examples
+    --------
+    >>> orders, ratios = accuracy_orders(accuracy_table(sizes=(17, 33), schemes=("linear",), sites=2000))
+    >>> round(orders[0]["order_max_rel"], 1), ratios[0]["vs_linear_max_rel"]
+    (1.9, 1.0)
+    """
+    orders, ratios = [], []
+    by = {(r["scheme"], r["n"]): r for r in rows}
+    schemes = list(dict.fromkeys(r["scheme"] for r in rows))
+    sizes = sorted({r["n"] for r in rows})
+    for s in schemes:
+        for a, b in zip(sizes, sizes[1:]):
+            if (s, a) in by and (s, b) in by:
+                orders.append({"scheme": s, "grids": f"{a} -> {b}",
+                               **{f"order_{k}": float(np.log(by[s, a][k] / by[s, b][k]) / np.log((b - 1) / (a - 1)))
+                                  for k in _ORDER_KEYS}})
+        for n in sizes:
+            if (s, n) in by and ("linear", n) in by:
+                ratios.append({"scheme": s, "grid": f"{n}x{n}",
+                               **{f"vs_{base}_{k}": by[s, n][k] / by[base, n][k]
+                                  for base in ("linear", "C2") if (base, n) in by for k in _ORDER_KEYS}})
+    return orders, ratios
 
 
 def _normal_angles(n_render, n_true):
@@ -389,6 +442,38 @@ def _write_pareto(out, result):
              ("note", "note", "s")]))
 
 
+def write_accuracy(out, result, sizes):
+    """The accuracy table, its orders and ratios to linear: ``result["accuracy"]``, ``["accuracy_orders"]``,
+    ``["accuracy_vs_linear"]`` and ``out/accuracy_table.md`` (``splinevis study terrain`` calls it; alone it
+    takes a few seconds: ``write_accuracy(dir, {}, (13, 25, 49))``)."""
+    out = Path(out)
+    result["accuracy"] = accuracy_table(sizes=sizes, sites=100_000)
+    result["accuracy_orders"], result["accuracy_vs_linear"] = accuracy_orders(result["accuracy"])
+    err_cols = [("value max (inner)", "inner_max_rel", "e"), ("gradient max (full)", "grad_max_rel", "e"),
+                ("gradient max (inner)", "inner_grad_max_rel", "e")]
+    order_cols = [("value (full)", "order_max_rel", "f2"), ("value (inner)", "order_inner_max_rel", "f2"),
+                  ("gradient (full)", "order_grad_max_rel", "f2"), ("gradient (inner)", "order_inner_grad_max_rel", "f2")]
+    ratio_cols = [("value (full)", "vs_linear_max_rel", "e"), ("value (inner)", "vs_linear_inner_max_rel", "e"),
+                  ("gradient (full)", "vs_linear_grad_max_rel", "e"), ("gradient (inner)", "vs_linear_inner_grad_max_rel", "e")]
+    (out / "accuracy_table.md").write_text(
+        "# Franke's function: relative errors over 100,000 random sites\n\n" + md_table(
+            result["accuracy"],
+            [("scheme", "scheme", "s"), ("grid", "grid", "s"), ("data", "data_points", "int"), ("patches", "patches", "int"),
+             ("rms (rel)", "rms_rel", "e"), ("max (rel)", "max_rel", "e")] + err_cols
+            + paper_columns([("rms", "paper_rms_rel", "e"), ("max", "paper_max_rel", "e")]))
+        + "\n'paper' = [Reis2008, Table I] at 144 data points (12x12); our grids have n x n points with n = 4k+1 so the C0 "
+          "scheme's 4x4 macro cells fit; the 13x13 row is the nearest size. Values relative to the largest |height|, "
+          "gradients (physical units) to the largest |gradient| of Franke's function; inner = the sites in "
+          f"[{INNER_MARGIN}, {1 - INNER_MARGIN}]^2, full = all of [0, 1]^2 (the boundary included).\n"
+        + "\n## Observed orders (log2 of the max error's ratio from one grid to the next, h halved)\n\n"
+        + md_table(result["accuracy_orders"], [("scheme", "scheme", "s"), ("grids", "grids", "s")] + order_cols)
+        + "\n## Max error relative to linear interpolation on the same grid\n\n"
+        + md_table(result["accuracy_vs_linear"], [("scheme", "scheme", "s"), ("grid", "grid", "s")] + ratio_cols)
+        + "\n## Max error relative to the plain C2 box spline (data as coefficients) on the same grid\n\n"
+        + md_table(result["accuracy_vs_linear"], [("scheme", "scheme", "s"), ("grid", "grid", "s")]
+                   + [(t, k.replace("vs_linear", "vs_C2"), f) for t, k, f in ratio_cols]))
+
+
 def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
     """Run the study; returns the dict also written to ``out_dir/terrain.json``.
 
@@ -409,15 +494,7 @@ def run_terrain_study(out_dir, *, quick=False, progress=True) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     result = {"quick": quick}
     sizes = (13, 25, 49) if quick else (13, 25, 49, 97)
-    result["accuracy"] = accuracy_table(sizes=sizes, sites=100_000)
-    (out / "accuracy_table.md").write_text(
-        "# Franke's function: relative errors over 100,000 random sites\n\n" + md_table(
-            result["accuracy"],
-            [("scheme", "scheme", "s"), ("grid", "grid", "s"), ("data", "data_points", "int"), ("patches", "patches", "int"),
-             ("rms (rel)", "rms_rel", "e"), ("max (rel)", "max_rel", "e")]
-            + paper_columns([("rms", "paper_rms_rel", "e"), ("max", "paper_max_rel", "e")]))
-        + "\n'paper' = [Reis2008, Table I] at 144 data points (12x12); our grids have n x n points with n = 4k+1 so the C0 "
-          "scheme's 4x4 macro cells fit; the 13x13 row is the nearest size.\n")
+    write_accuracy(out, result, sizes)
     comparison_figure(out / "comparison_normals_shading_lines.png")
     result["accuracy_vs_time"] = accuracy_vs_time(quick=quick, progress=progress)
     _write_pareto(out, result)

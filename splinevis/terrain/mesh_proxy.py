@@ -158,7 +158,7 @@ def cell_lifts(terrain, k: int) -> np.ndarray:
 
 #: Schemes whose spline is C1 across cell edges: a mesh square spanning several cells may use the Hessian bound
 #: (Taylor's theorem with integral remainder needs f in C1 with piecewise bounded second derivatives).
-C1_SCHEMES = ("C1", "C2", "C2-cubic")
+C1_SCHEMES = ("C1", "C2", "C2-cubic", "C2-interp")
 
 
 def mesh_block(terrain, k: int = 1) -> int:

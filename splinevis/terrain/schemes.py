@@ -14,6 +14,9 @@ C2          1x1 data cells         C2          degree 1     4x4, [-1, 2]^2 (quar
                                                             coefficients: smoothing)
 C2-cubic    1x1 data cells         C2          degree 3     30 points of [-2, 3]^2 (box spline with the
                                                             prefilter 3/2 z - 1/12 * 6 neighbours)
+C2-interp   1x1 data cells         C2          degree 3     global: the C2 stencil on heights prefiltered
+                                                            so the spline interpolates the samples
+                                                            (:mod:`splinevis.terrain.interpolating`)
 ==========  =====================  ==========  ===========  =============================================
 
 Conventions
@@ -38,7 +41,8 @@ This module defines the schemes and the public interface. The stencil engine tha
 weights to all cells, with the cubic padding, is :mod:`splinevis.terrain.engine`; the quartic BB tables of
 a cell and the smoothness conditions between cells are :mod:`splinevis.terrain.cell`; the derivation of
 the C1 weights is :mod:`splinevis.terrain.c1_scheme`; the box-spline C2 schemes are
-:mod:`splinevis.terrain.box_spline`.
+:mod:`splinevis.terrain.box_spline`, and the prefilter (a sparse solve) of the interpolating one,
+``C2-interp``, is :mod:`splinevis.terrain.interpolating`.
 
 References
 ----------
@@ -71,11 +75,15 @@ __all__ = [
 ]
 
 #: Names accepted by :func:`terrain_coefficients`.
-SCHEMES = ("linear", "C0", "C1", "C2", "C2-cubic")
+SCHEMES = ("linear", "C0", "C1", "C2", "C2-cubic", "C2-interp")
 
-_SMOOTHNESS = {"linear": 0, "C0": 0, "C1": 1, "C2": 2, "C2-cubic": 2}
-_REPRODUCES = {"linear": 1, "C0": 4, "C1": 3, "C2": 1, "C2-cubic": 3}
-_MIN_SIZE = {"linear": 2, "C0": 5, "C1": 4, "C2": 4, "C2-cubic": 4}
+#: The schemes whose coefficients are a fixed local stencil of the heights (what :func:`scheme_stencil` and the
+#: out-of-core tiles need); ``C2-interp`` is global (a solve over the whole grid).
+STENCIL_SCHEMES = ("linear", "C0", "C1", "C2", "C2-cubic")
+
+_SMOOTHNESS = {"linear": 0, "C0": 0, "C1": 1, "C2": 2, "C2-cubic": 2, "C2-interp": 2}
+_REPRODUCES = {"linear": 1, "C0": 4, "C1": 3, "C2": 1, "C2-cubic": 3, "C2-interp": 3}
+_MIN_SIZE = {"linear": 2, "C0": 5, "C1": 4, "C2": 4, "C2-cubic": 4, "C2-interp": 4}
 
 
 @dataclass(frozen=True)
@@ -163,6 +171,10 @@ def scheme_stencil(scheme):
     (np.float64(1.0), np.float64(1.0))
     """
     check_choice(scheme, "scheme", SCHEMES)
+    if scheme not in STENCIL_SCHEMES:
+        raise ValueError(f"scheme {scheme} has no local stencil: its coefficients are the C2 stencil "
+                         f"(scheme_stencil('C2')) applied to heights prefiltered by a solve over the whole grid "
+                         f"(splinevis.terrain.interpolating.prefilter_heights).")
     st = _BUILDERS[scheme]()
     offs = _offsets(st.x0, st.y0, st.kw, st.kh)
     keep = [s for s in range(len(offs)) if np.any(st.W[s] != 0.0)]
@@ -207,7 +219,8 @@ def terrain_coefficients(z, scheme="C1"):
         (quartic interpolation at all domain points; needs sizes 4k + 1, see :func:`resample_for_c0`),
         ``"C1"`` (C1 quasi-interpolant exact on cubics), ``"C2"`` (the quartic box spline of [Reis2008, sec. IV] with the
         data as coefficients; smooths, exact on linear functions), ``"C2-cubic"`` (the same spline with
-        cubic-exact coefficients).
+        cubic-exact coefficients), ``"C2-interp"`` (the same spline interpolating the heights: the C2 stencil
+        on prefiltered heights, :func:`splinevis.terrain.interpolating.prefilter_heights`).
 
     Returns
     -------
@@ -221,7 +234,7 @@ def terrain_coefficients(z, scheme="C1"):
     ValueError
         Unknown scheme (the message lists :data:`SCHEMES`), ``z`` not 2-D, a non-finite height (the
         message names its row and column), a grid below the scheme's minimum size (2x2 for linear, 4x4
-        for C1, C2, C2-cubic, 5x5 for C0) or, for C0, sizes that are not 4k + 1.
+        for C1, C2, C2-cubic, C2-interp, 5x5 for C0) or, for C0, sizes that are not 4k + 1.
     TypeError
         ``z`` is not numeric.
 
@@ -233,8 +246,14 @@ def terrain_coefficients(z, scheme="C1"):
     ((1, 2, 2, 15), 4, 0)
     """
     z = _check_heights(z, scheme)
-    st = _BUILDERS[scheme]()
-    coef = _apply(z, st)
+    if scheme == "C2-interp":
+        from .interpolating import prefilter_heights
+
+        st = _c2()
+        coef = _apply(prefilter_heights(z), st)
+    else:
+        st = _BUILDERS[scheme]()
+        coef = _apply(z, st)
     info = TerrainInfo(scheme=scheme, cell_size=st.step, degree=_DEG, smoothness=_SMOOTHNESS[scheme],
                        reproduces=_REPRODUCES[scheme], cells=coef.shape[:2], data_shape=z.shape)
     return coef, info
