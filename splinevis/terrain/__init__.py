@@ -1,5 +1,5 @@
 """Terrain splines: quartic Bernstein-Bezier patches on the type-1 triangulation of a height grid
-(schemes linear, C0, C1, C2 and C2-cubic; see :mod:`.schemes` and ``docs/terrain-schemes.md``)."""
+(schemes linear, C0, C1, C2, C2-cubic and C2-interp; see :mod:`.schemes` and ``docs/terrain-schemes.md``)."""
 
 from .schemes import (
     C1_STENCIL as C1_STENCIL,
