@@ -31,10 +31,43 @@ from .._validation import as_float64_array
 from .schemes import evaluate_volume
 from .trilinear import trilinear_interpolate
 
-__all__ = ["ALL_SCHEMES", "sample_field", "evaluation_points", "scheme_errors", "approximation_table"]
+__all__ = ["ALL_SCHEMES", "FIDELITY_METHODS", "parse_method", "sample_field", "evaluation_points", "scheme_errors",
+           "approximation_table"]
 
 #: Schemes of the study: the trilinear baseline and the two splines.
 ALL_SCHEMES = ("trilinear", "quadratic", "cubic")
+
+#: The methods side by side in the data-fidelity table (``splinevis study volume``): what VTK shades with
+#: (trilinear values, trilinear interpolation of central-difference gradients), the paper's splines, the plain
+#: quadratic spline with quadratic padding, and the prefiltered splines (:mod:`splinevis.volume.prefilter`).
+FIDELITY_METHODS = ("trilinear", "central-differences", "quadratic", "cubic", "quadratic/quadratic",
+                    "quadratic+local/quadratic", "cubic+local/quadratic", "cubic+interpolate/cubic")
+
+
+def parse_method(name: str) -> dict:
+    """A method of the study by name: ``"trilinear"``, ``"central-differences"`` (trilinear values; gradients
+    trilinearly interpolated from central differences of the samples, one-sided at the boundary, as VTK's
+    volume mappers shade) or ``"<scheme>[+<prefilter>][/<padding>]"`` for a spline (prefilter ``none`` and
+    padding ``linear`` when left out).
+
+    >>> parse_method("cubic+interpolate/cubic")
+    {'kind': 'spline', 'scheme': 'cubic', 'prefilter': 'interpolate', 'padding': 'cubic'}
+    >>> parse_method("quadratic")["padding"], parse_method("central-differences")["kind"]
+    ('linear', 'central-differences')
+    """
+    from .prefilter import PREFILTERS
+    from .stencil import PADDINGS
+
+    if name in ("trilinear", "central-differences"):
+        return {"kind": name}
+    base, _, padding = str(name).partition("/")
+    scheme, _, prefilter = base.partition("+")
+    spec = {"kind": "spline", "scheme": scheme, "prefilter": prefilter or "none", "padding": padding or "linear"}
+    if scheme not in ("quadratic", "cubic") or spec["prefilter"] not in PREFILTERS or spec["padding"] not in PADDINGS:
+        raise ValueError(f"method {name!r} is not known: use 'trilinear', 'central-differences' or "
+                         f"'<scheme>[+<prefilter>][/<padding>]' with scheme quadratic|cubic, prefilter one of "
+                         f"{PREFILTERS}, padding one of {tuple(PADDINGS)}.")
+    return spec
 
 
 def _bounds(field):
@@ -80,8 +113,11 @@ def sample_field(field, n: int) -> np.ndarray:
     return vals.reshape(n, n, n)
 
 
-def evaluation_points(field, n_points: int, coarsest: int, seed: int = 0) -> np.ndarray:
-    """``n_points`` uniform random world points at least 2 cells of the ``coarsest`` grid from the boundary.
+def evaluation_points(field, n_points: int, coarsest: int, seed: int = 0, *, region: str = "inner") -> np.ndarray:
+    """``n_points`` uniform random world points at least 2 cells of the ``coarsest`` grid from the boundary
+    (``region="inner"``), or anywhere in the sampled box (``region="full"``: the boundary cells too, where
+    the splines read the padding; every fourth point is moved onto a face of the box, so that every grid size
+    is measured at index distance 0 from the boundary, where the padding's error is largest).
 
     Examples
     --------
@@ -90,13 +126,35 @@ def evaluation_points(field, n_points: int, coarsest: int, seed: int = 0) -> np.
     >>> p = evaluation_points(Box(), 1000, 11)  # cells of 0.1: the points keep 0.2 from the faces
     >>> p.shape, bool(p.min() >= 0.2 and p.max() <= 0.8)
     ((1000, 3), True)
+    >>> bool(evaluation_points(Box(), 1000, 11, region="full").min() < 0.01)
+    True
     """
     b = _bounds(field)
     coarsest = _check_size(coarsest)
+    if region not in ("inner", "full"):
+        raise ValueError(f"region must be 'inner' or 'full', got {region!r}.")
     lo, hi = b[0::2], b[1::2]
-    margin = 2 * (hi - lo) / (coarsest - 1)
+    margin = 2 * (hi - lo) / (coarsest - 1) if region == "inner" else 0.0 * lo
     rng = np.random.default_rng(seed)
-    return lo + margin + rng.random((int(n_points), 3)) * (hi - lo - 2 * margin)
+    p = lo + margin + rng.random((int(n_points), 3)) * (hi - lo - 2 * margin)
+    if region == "full":
+        on_face = np.arange(len(p))[::4]
+        axis = rng.integers(0, 3, len(on_face))
+        side = rng.integers(0, 2, len(on_face))
+        p[on_face, axis] = np.where(side == 1, hi[axis], lo[axis])
+    return p
+
+
+def central_difference_gradients(volume) -> np.ndarray:
+    """(nz, ny, nx, 3) index-space gradients ``(d/dx, d/dy, d/dz)`` of the samples by central differences,
+    one-sided (first order) on the boundary samples: what VTK's volume mappers shade with.
+
+    >>> z, y, x = np.mgrid[0:3, 0:3, 0:4].astype(float)
+    >>> central_difference_gradients(x ** 2)[0, 0, :, 0]  # 2x inside; one-sided at the ends
+    array([1., 2., 4., 5.])
+    """
+    v = np.asarray(volume, dtype=np.float64)
+    return np.stack([np.gradient(v, axis=a) for a in (2, 1, 0)], axis=-1)
 
 
 def _reconstruct(volume, field, points, scheme):
@@ -105,11 +163,24 @@ def _reconstruct(volume, field, points, scheme):
     lo = b[0::2]
     h = (b[1::2] - lo) / (n - 1)
     idx = (points - lo) / h
-    if scheme == "trilinear":
+    spec = parse_method(scheme)
+    if spec["kind"] == "trilinear":
         v, g = trilinear_interpolate(volume, idx, gradient=True)
+    elif spec["kind"] == "central-differences":
+        v = trilinear_interpolate(volume, idx)
+        G = central_difference_gradients(volume)
+        g = np.stack([trilinear_interpolate(G[..., a], idx) for a in range(3)], axis=-1)
     else:
-        v, g = evaluate_volume(volume, idx, scheme, gradient=True)
+        v, g = evaluate_volume(volume, idx, spec["scheme"], gradient=True, prefilter=spec["prefilter"],
+                               padding=spec["padding"])
     return v, g / h
+
+
+def _angles_deg(g, fg):
+    """Angle in degrees between reconstructed and true gradients (0 where both vanish)."""
+    ng, nf = np.linalg.norm(g, axis=1), np.linalg.norm(fg, axis=1)
+    cos = np.einsum("ij,ij->i", g, fg) / np.where(ng * nf > 0, ng * nf, 1.0)
+    return np.degrees(np.arccos(np.clip(np.where(ng * nf > 0, cos, 1.0), -1.0, 1.0)))
 
 
 def scheme_errors(field, n: int, scheme: str, points, *, relative: bool = False, volume=None) -> dict:
@@ -129,7 +200,9 @@ def scheme_errors(field, n: int, scheme: str, points, *, relative: bool = False,
     Returns
     -------
     dict with ``scheme, n, h`` (the largest grid spacing), ``value_max, value_rms, gradient_max,
-    gradient_rms``.
+    gradient_rms`` and the angle between reconstructed and true gradient in degrees, ``angle_mean,
+    angle_median, angle_rms, angle_max`` (a normal's error on an isosurface through the point).
+    ``scheme`` is any method of :func:`parse_method`.
 
     Examples
     --------
@@ -149,8 +222,11 @@ def scheme_errors(field, n: int, scheme: str, points, *, relative: bool = False,
     >>> bool(scheme_errors(Square(), 11, "trilinear", points)["gradient_max"] > 0.05)
     True
     """
-    if scheme not in ALL_SCHEMES:
-        raise ValueError(f"scheme {scheme!r} is not known; choose one of {ALL_SCHEMES}.")
+    try:
+        parse_method(scheme)
+    except ValueError:
+        raise ValueError(f"scheme {scheme!r} is not known; choose one of {ALL_SCHEMES} or a method of "
+                         f"parse_method (e.g. {FIDELITY_METHODS[-1]!r}).") from None
     n = _check_size(n)
     p = as_float64_array(points, "points", shape_tail=(3,)).reshape(-1, 3)
     vol = sample_field(field, n) if volume is None else volume
@@ -159,18 +235,22 @@ def scheme_errors(field, n: int, scheme: str, points, *, relative: bool = False,
     fg = np.asarray(field.gradient(p), dtype=np.float64)
     ev = np.abs(v - fv)
     eg = np.linalg.norm(g - fg, axis=1)
+    ang = _angles_deg(g, fg)
     if relative:
         ev = ev / (fv.max() - fv.min())
         eg = eg / np.linalg.norm(fg, axis=1).max()
     b = _bounds(field)
     return {"scheme": scheme, "n": n, "h": float(((b[1::2] - b[0::2]) / (n - 1)).max()),
             "value_max": float(ev.max()), "value_rms": float(np.sqrt(np.mean(ev ** 2))),
-            "gradient_max": float(eg.max()), "gradient_rms": float(np.sqrt(np.mean(eg ** 2)))}
+            "gradient_max": float(eg.max()), "gradient_rms": float(np.sqrt(np.mean(eg ** 2))),
+            "angle_mean": float(ang.mean()), "angle_median": float(np.median(ang)),
+            "angle_rms": float(np.sqrt(np.mean(ang ** 2))), "angle_max": float(ang.max())}
 
 
 def approximation_table(field, sizes=(16, 32, 64, 128), schemes=ALL_SCHEMES, n_points: int = 20000, seed: int = 0,
-                        *, relative: bool = False) -> list:
-    """Error table of ``schemes`` on ``n^3`` samples of ``field`` for each n in ``sizes``.
+                        *, relative: bool = False, region: str = "inner") -> list:
+    """Error table of ``schemes`` (any methods of :func:`parse_method`) on ``n^3`` samples of ``field`` for
+    each n in ``sizes``, at points of ``region`` (:func:`evaluation_points`).
 
     Returns
     -------
@@ -193,16 +273,19 @@ def approximation_table(field, sizes=(16, 32, 64, 128), schemes=ALL_SCHEMES, n_p
     """
     sizes = sorted(_check_size(n) for n in sizes)
     for s in schemes:
-        if s not in ALL_SCHEMES:
-            raise ValueError(f"scheme {s!r} is not known; choose from {ALL_SCHEMES}.")
-    pts = evaluation_points(field, n_points, sizes[0], seed)
+        try:
+            parse_method(s)
+        except ValueError:
+            raise ValueError(f"scheme {s!r} is not known; choose from {ALL_SCHEMES} or a method of parse_method "
+                             f"(e.g. {FIDELITY_METHODS[-1]!r}).") from None
+    pts = evaluation_points(field, n_points, sizes[0], seed, region=region)
     rows = {s: [] for s in schemes}
     for n in sizes:
         vol = sample_field(field, n)
         for s in schemes:
-            rows[s].append(scheme_errors(field, n, s, pts, relative=relative, volume=vol))
+            rows[s].append({**scheme_errors(field, n, s, pts, relative=relative, volume=vol), "region": region})
     out = []
-    keys = ("value_max", "value_rms", "gradient_max", "gradient_rms")
+    keys = ("value_max", "value_rms", "gradient_max", "gradient_rms", "angle_mean")
     for s in schemes:
         prev = None
         for r in rows[s]:

@@ -3,7 +3,7 @@
 Each is a :class:`~splinevis.gl.contract.HardCase` rendered at 160 x 120 and compared per pixel by the tests
 and the self-test (:func:`splinevis.analysis.agreement.depth_agreement`): both schemes with every encoding,
 proxy kind and root finder, anisotropic spacing with a UTM-sized origin, huge spacing, the camera inside the
-volume, noisy data, integer and float32 data, a plateau exactly at the isovalue and a sheet one voxel thick.
+volume, noisy data, prefiltered data (a noisy interpolating cubic) with higher-order padding, integer and float32 data, a plateau exactly at the isovalue and a sheet one voxel thick.
 The distance field of a sphere is the common test data (:func:`sphere_grid`).
 """
 
@@ -60,6 +60,14 @@ def _huge():
     return Isosurface(VolumeSpline(sphere_grid(spacing=(1.0e3, 1.0e3, 1.0e3), origin=(0.0, 0.0, 0.0))), 0.7)
 
 
+def _prefiltered(scheme, prefilter, padding, noise=0.0):
+    # prefiltered data (splinevis.volume.prefilter) overshoot the samples, most for noisy data interpolated by the
+    # cubic (the checkerboard frequency is amplified ~n^2 / 1.2); the sphere is cut by the domain's faces, where the
+    # spline reads the higher-order padding
+    g = sphere_grid(n=16, noise=noise)
+    return Isosurface(VolumeSpline(g, scheme, prefilter=prefilter, padding=padding), 1.05)
+
+
 def _dtype(name):
     dtype = np.dtype(name)
     g = sphere_grid()
@@ -91,7 +99,7 @@ def hard_cases() -> list:
     --------
     >>> cases = hard_cases()
     >>> len(cases), cases[0].name, cases[0].window_size, cases[1].program_options
-    (21, 'quadratic-sphere-blocks-data-analytic', (160, 120), {'encoding': 'coefficients'})
+    (23, 'quadratic-sphere-blocks-data-analytic', (160, 120), {'encoding': 'coefficients'})
     """
     quad, cubic = functools.partial(_sphere, "quadratic"), functools.partial(_sphere, "cubic")
     case = functools.partial(HardCase, min_hits=500 / 19200)  # at least 500 pixels of 160 x 120 show the surface
@@ -114,6 +122,10 @@ def hard_cases() -> list:
         HardCase("camera-inside-volume", functools.partial(_sphere, "quadratic", 24),
                  [(0.9, 0.1, 0.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)], min_hits=2000 / 19200),
         case("noisy-data", functools.partial(_sphere, "quadratic", 20, 0.02), CAMERA),
+        case("quadratic-local-prefilter-quadratic-padding",
+             functools.partial(_prefiltered, "quadratic", "local", "quadratic"), CAMERA),
+        case("cubic-interpolating-noisy-cubic-padding",
+             functools.partial(_prefiltered, "cubic", "interpolate", "cubic", 0.02), CAMERA),
     ]
     cases += [case(f"{name}-data", functools.partial(_dtype, name), CAMERA)
               for name in ("uint8", "uint16", "int16", "float32")]
