@@ -1,5 +1,5 @@
 """Prefiltered and interpolating volume splines, and the padding that keeps the orders up to the boundary
-(splinevis.volume.prefilter, splinevis.volume.stencil.PADDINGS; issue 14 items 1-2), on the float64 twins.
+(splinevis.volume.prefilter, splinevis.volume.stencil.PADDINGS), on the float64 twins.
 
 The orders follow from polynomial reproduction (a bounded linear scheme that reproduces every polynomial of
 degree < p has errors O(h^p) for values and O(h^(p-1)) for gradients, by Taylor's theorem on the stencil):

@@ -1,6 +1,6 @@
 """Prefiltered volume splines: the data the type-6 schemes read, chosen so that the spline reproduces
 quadratics (``"local"``) or interpolates the samples (``"interpolate"``), beyond [Kalbe2008]; the plain
-quasi-interpolant of the paper is ``"none"``. Cardinal prefiltering in the sense of [Unser1999]; see
+quasi-interpolant of the paper is ``"none"``. Cardinal prefiltering in the sense of [Unser1993]; see
 docs/volume-schemes.md, "Prefiltered and interpolating splines".
 
 Why our own: scipy.ndimage.spline_filter prefilters tensor-product B-splines (a separable recursive
