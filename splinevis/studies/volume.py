@@ -7,6 +7,10 @@ Writes ``DIR/volume.json``, ``DIR/volume.md`` (every table) and figures:
    cubic reconstructions on n^3 samples of Marschner-Lobb and of a smooth field (the Gaussian blob), from
    :func:`splinevis.volume.approximation.approximation_table` (max errors over 20,000 random interior
    points, observed orders between sizes).
+1b. **Data fidelity** (``fidelity.png``): value and gradient errors and gradient angles of trilinear, central
+   differences (what VTK shades with), the paper's splines and the prefiltered and interpolating splines
+   (:mod:`splinevis.volume.prefilter`) side by side, inner region and full box, n = 33, 65, 129
+   (:func:`splinevis.studies.volume_accuracy.fidelity_rows`).
 2. **Accuracy vs time** (``pareto.png``): the isosurface of a sampled torus distance field (exact ray hits
    exist) in one camera and window. Per pixel against the exact torus: coverage mismatch (pixels covered
    by the method but not by the exact surface or vice versa), hit-position error (distance of the shown
@@ -56,9 +60,10 @@ from pathlib import Path
 
 from .report import clean, log, md_table, write_json
 from .volume_accuracy import (CAMERA, CLIP, QUICK_WINDOW, WINDOW, Reference, accuracy_vs_time, approximation_rows,
+                              fidelity_rows,
                               exact_reference, measure_mesh, measure_spline, measure_vtk, normals_from_two_sided,
                               spline_configs, unproject)
-from .volume_figures import ML_CAMERA, approximation_figure, pareto_figure, side_by_side_figure
+from .volume_figures import ML_CAMERA, approximation_figure, fidelity_figure, pareto_figure, side_by_side_figure
 from .volume_memory import PAPER_TABLE_1, memory_markdown, memory_rows
 
 __all__ = ["run_volume_study", "cubic_status", "exact_reference", "measure_spline", "measure_mesh", "measure_vtk",
@@ -101,6 +106,21 @@ def _markdown(result) -> str:
         ("field", "field", "s"), ("scheme", "scheme", "s"), ("n", "n", "s"), ("h", "h", "e"),
         ("value max", "value_max", "e"), ("order", "order_value_max", "f2"), ("gradient max", "gradient_max", "e"),
         ("order", "order_gradient_max", "f2"), ("gradient rms", "gradient_rms", "e")]))
+    if result.get("fidelity"):
+        n = max(r["n"] for r in result["fidelity"])
+        md.append(f"\n## 1b. Data fidelity side by side (n = {n}; 20,000 random points per region; inner: 2 cells of the "
+                  "coarsest grid from the boundary; full: the whole sampled box, a quarter of the points on its faces)\n")
+        md.append("Methods: `trilinear` (values and the exact gradient of the trilinear interpolant), `central-differences` "
+                  "(trilinear values, gradients trilinearly interpolated from central differences: what VTK shades with), "
+                  "the paper's splines (`quadratic`, `cubic`: linear padding), and `scheme+prefilter/padding` "
+                  "(splinevis.volume.prefilter: `local` reproduces quadratics, `interpolate` interpolates the samples). "
+                  "Angles between the reconstructed and the true gradient, degrees. Orders against the previous size.\n")
+        md.append(md_table([r for r in result["fidelity"] if r["n"] == n], [
+            ("field", "field", "s"), ("region", "region", "s"), ("method", "scheme", "s"),
+            ("value rms", "value_rms", "e"), ("value max", "value_max", "e"), ("order", "order_value_max", "f2"),
+            ("gradient rms", "gradient_rms", "e"), ("gradient max", "gradient_max", "e"),
+            ("order", "order_gradient_max", "f2"), ("angle mean °", "angle_mean", "e"),
+            ("angle median °", "angle_median", "e"), ("angle rms °", "angle_rms", "e")]))
     s = result["accuracy_setup"]
     md.append(f"\n## 2. Accuracy vs time ({s['field']}, {s['grid']} samples, h = {s['h']:.4f}, "
               f"{s['window'][0]}x{s['window'][1]} window, {s['pixels_exact']} exact pixels; a pixel is "
@@ -119,6 +139,7 @@ def _markdown(result) -> str:
         ("VTK read-out floor median/p95 °", "floor", "s"), ("GPU vs twin coverage px", "gpu_twin_coverage_disagree", "int")]))
     md.extend(memory_markdown(result["memory"]))
     md.append("\n## 4. Figures\n\n* `approximation.png` - error vs h (log-log) with slopes\n"
+              "* `fidelity.png` - value RMS and mean gradient angle of every method at the finest grid\n"
               "* `pareto.png` - normal error and coverage mismatch vs frame time\n"
               "* `side_by_side.png` - Marschner-Lobb 41^3 close-up: MC 1x | VTK trilinear | quadratic | cubic; "
               "row 2 reflection lines (splines and the mesh; VTK's volume: plain shading)\n")
@@ -153,6 +174,8 @@ def run_volume_study(out_dir, *, quick=False, progress=True) -> dict:
     result["approximation"] = approximation_rows(sizes=(16, 32, 64) if quick else (16, 32, 64, 128), schemes=schemes,
                                                  progress=progress)
     approximation_figure(result["approximation"], out / "approximation.png")
+    result["fidelity"] = fidelity_rows(sizes=(33, 65) if quick else (33, 65, 129), progress=progress)
+    fidelity_figure(result["fidelity"], out / "fidelity.png")
     rows, setup = accuracy_vs_time(quick=quick, cubic=cubic, progress=progress)
     for r in rows:
         if r.get("quantisation_floor_median_deg") is not None:

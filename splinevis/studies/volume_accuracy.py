@@ -15,7 +15,7 @@ import numpy as np
 
 from .report import error_summary, progress_bar, timed
 
-__all__ = ["WINDOW", "QUICK_WINDOW", "CAMERA", "CLIP", "approximation_rows", "set_camera", "unproject", "Reference",
+__all__ = ["WINDOW", "QUICK_WINDOW", "CAMERA", "CLIP", "approximation_rows", "fidelity_rows", "set_camera", "unproject", "Reference",
            "exact_reference", "measure_spline", "measure_mesh", "measure_vtk", "normals_from_two_sided",
            "spline_configs", "accuracy_vs_time"]
 
@@ -49,6 +49,31 @@ def approximation_rows(sizes=(16, 32, 64, 128), schemes=("trilinear", "quadratic
 
 
 # ------------------------------------------------------------------------------------------ the exact surface
+def fidelity_rows(sizes=(33, 65, 129), methods=None, n_points=20000, progress=True):
+    """Data fidelity side by side: value and gradient errors (and gradient angles) of trilinear interpolation,
+    central differences (what VTK shades with), the paper's splines and the prefiltered ones
+    (:data:`splinevis.volume.approximation.FIDELITY_METHODS`) on Marschner-Lobb and the Gaussian blob, in the
+    inner region and the full sampled box (``region`` key).
+
+    Examples
+    --------
+    >>> rows = fidelity_rows(sizes=(9, 17), methods=("trilinear", "quadratic+local/quadratic"), n_points=500,
+    ...                      progress=False)
+    >>> sorted({(r["field"], r["region"]) for r in rows})[:2], len(rows)
+    ([('blob', 'full'), ('blob', 'inner')], 16)
+    """
+    from datasets_synthetic.volumes import blob, marschner_lobb
+    from ..volume.approximation import FIDELITY_METHODS, approximation_table
+
+    methods = tuple(methods or FIDELITY_METHODS)
+    rows = []
+    jobs = [(f, region) for f in (marschner_lobb(), blob()) for region in ("inner", "full")]
+    for field, region in progress_bar(jobs, "data fidelity", enabled=progress):
+        for r in approximation_table(field, sizes=sizes, schemes=methods, n_points=n_points, region=region):
+            rows.append({"field": field.name, **r})
+    return rows
+
+
 def set_camera(pl, camera=CAMERA, clip=CLIP):
     """Put the study camera (or ``camera``) on a plotter, with a fixed clipping range.
 
@@ -249,7 +274,9 @@ def measure_spline(ref: Reference, spline, *, roots=None, iterations=2, encoding
     twin_cov = hits.hit
     points = ref.o + np.where(twin_cov, hits.t, np.nan)[..., None] * ref.d
     normals = hits.normals
-    row = {"kind": f"spline {spline.scheme}", "method": f"{spline.scheme} spline",
+    variant = "" if getattr(spline, "prefilter", "none") == "none" and getattr(spline, "padding", "linear") == "linear" \
+        else f" ({spline.prefilter} prefilter, {spline.padding} padding)"
+    row = {"kind": f"spline {spline.scheme}", "method": f"{spline.scheme} spline{variant}",
            "config": f"{proxy}, {encoding}, {roots}" + ("" if roots == "analytic" else f", {iterations} it."),
            "scheme": spline.scheme, "encoding": encoding, "roots": roots, "proxy": proxy,
            "iterations": None if roots == "analytic" else iterations, "elements": int(rel.num_tets),
@@ -405,7 +432,8 @@ def measure_vtk(ref: Reference, *, sample_distance=None, repeats=3) -> dict:
 
 # ------------------------------------------------------------------------------------------ the sweep
 def spline_configs(quick, cubic):
-    """(scheme, encoding, roots, iterations, proxy) of the measured spline programs. The Newton iteration
+    """(method, encoding, roots, iterations, proxy) of the measured spline programs; a method is a scheme or a
+    prefiltered spline (:func:`splinevis.volume.approximation.parse_method`). The Newton iteration
     of [Kalbe2008] (``"paper"``) exists for the cubic only: the paper solves quadratics in closed form.
 
     Examples
@@ -413,17 +441,21 @@ def spline_configs(quick, cubic):
     >>> from splinevis.studies.volume_accuracy import spline_configs
     >>> spline_configs(quick=True, cubic=False)
     [('quadratic', 'data', 'analytic', 1, 'blocks'), ('quadratic', 'coefficients', 'analytic', 1, 'blocks'),
-     ('quadratic', 'data', 'analytic', 1, 'cubes')]
+     ('quadratic', 'data', 'analytic', 1, 'cubes'), ('quadratic+local/quadratic', 'data', 'analytic', 1, 'blocks')]
     >>> len(spline_configs(quick=True, cubic=True)), len(spline_configs(quick=False, cubic=True))
-    (7, 14)
+    (9, 17)
     """
     q = [("quadratic", "data", "analytic", 1, "blocks"), ("quadratic", "coefficients", "analytic", 1, "blocks"),
          ("quadratic", "data", "analytic", 1, "cubes")]
     c = [("cubic", "data", "analytic", 1, "blocks"), ("cubic", "determining", "analytic", 1, "blocks"),
          ("cubic", "data", "paper", 5, "blocks"),
          ("cubic", "data", "bracketed", 2, "blocks")]
+    # the prefiltered splines (data fidelity, splinevis.volume.prefilter): does it change where the spline wins?
+    q += [("quadratic+local/quadratic", "data", "analytic", 1, "blocks")]
+    c += [("cubic+local/quadratic", "data", "analytic", 1, "blocks")]
     if not quick:
         q += [("quadratic", "data", "bracketed", 2, "blocks"), ("quadratic", "data", "bracketed", 4, "blocks")]
+        c += [("cubic+interpolate/cubic", "data", "analytic", 1, "blocks")]
         c += [("cubic", "data", "paper", 2, "blocks"), ("cubic", "data", "paper", 8, "blocks"),
               ("cubic", "data", "bracketed", 4, "blocks"), ("cubic", "coefficients", "analytic", 1, "blocks"),
               ("cubic", "data", "analytic", 1, "cubes")]
@@ -433,6 +465,7 @@ def spline_configs(quick, cubic):
 def accuracy_vs_time(*, quick=False, cubic=True, repeats=None, n=None, progress=True):
     """Rows of every method on the sampled torus (see :mod:`splinevis.studies.volume`); and the set-up."""
     from datasets_synthetic.volumes import torus_distance
+    from ..volume.approximation import parse_method
     from ..volume.model import VolumeSpline
 
     field = torus_distance()
@@ -454,7 +487,8 @@ def accuracy_vs_time(*, quick=False, cubic=True, repeats=None, n=None, progress=
         else:
             _, scheme, enc, roots, k, proxy = job
             if scheme not in splines:
-                splines[scheme] = VolumeSpline(grid, scheme)
+                spec = parse_method(scheme)
+                splines[scheme] = VolumeSpline(grid, spec["scheme"], prefilter=spec["prefilter"], padding=spec["padding"])
             rows.append(measure_spline(ref, splines[scheme], roots=roots, iterations=k, encoding=enc, proxy=proxy,
                                        repeats=repeats))
     setup = {"field": f"torus distance R={field.R}, r={field.r}, isovalue {field.isovalue}", "grid": f"{n}^3",

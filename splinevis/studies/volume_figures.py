@@ -11,7 +11,7 @@ import numpy as np
 from .report import pyplot, save_figure
 from .volume_accuracy import set_camera
 
-__all__ = ["ML_CAMERA", "approximation_figure", "pareto_figure", "side_by_side_figure"]
+__all__ = ["ML_CAMERA", "approximation_figure", "fidelity_figure", "pareto_figure", "side_by_side_figure"]
 
 #: Close-up of Marschner-Lobb (side-by-side figure).
 ML_CAMERA = [(0.55, -0.95, 0.75), (0.05, -0.05, -0.05), (0.0, 0.0, 1.0)]
@@ -54,6 +54,50 @@ def approximation_figure(rows, path):
             ax.set_title(f"{name}: {label}", fontsize=10)
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=8, title="slope between the two finest", title_fontsize=7)
+    save_figure(fig, path)
+
+
+def fidelity_figure(rows, path):
+    """Data fidelity at the finest grid: value RMS error and mean gradient angle of every method, per field and
+    region (log-scale bars), from :func:`splinevis.studies.volume_accuracy.fidelity_rows`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> rows = [{"field": "ml", "region": "inner", "scheme": m, "n": 65, "value_rms": v, "angle_mean": a}
+    ...         for m, v, a in (("trilinear", 1e-2, 3.0), ("quadratic+local/quadratic", 1e-3, 0.5))]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     fidelity_figure(rows, Path(d) / "fidelity.png")
+    ...     (Path(d) / "fidelity.png").read_bytes()[1:4]
+    b'PNG'
+    """
+    plt = pyplot()
+    panels = sorted({(r["field"], r["region"]) for r in rows}, key=lambda fr: (fr[0], fr[1] != "inner"))
+    fig, axes = plt.subplots(2, len(panels), figsize=(3.9 * len(panels), 7.0), squeeze=False)
+    for j, (field, region) in enumerate(panels):
+        rs = [r for r in rows if r["field"] == field and r["region"] == region]
+        n = max(r["n"] for r in rs)
+        rs = [r for r in rs if r["n"] == n]
+        names = [r["scheme"] for r in rs]
+        base = {r["scheme"]: r for r in rs}
+        for i, (key, label, ref) in enumerate((("value_rms", "value RMS error", "trilinear"),
+                                                ("angle_mean", "mean gradient angle (deg)", "central-differences"))):
+            ax = axes[i, j]
+            vals = [r[key] for r in rs]
+            colours = ["0.6" if nm in ("trilinear", "central-differences") else
+                       ("tab:blue" if "+" not in nm else "tab:green") for nm in names]
+            ax.barh(range(len(vals)), vals, color=colours)
+            if ref in base:
+                ax.axvline(base[ref][key], color="k", lw=0.8, ls="--")
+            ax.set_xscale("log")
+            ax.xaxis.set_minor_formatter(plt.NullFormatter())  # decade labels only: no overlapping minor labels
+            ax.set_yticks(range(len(vals)))
+            ax.set_yticklabels(names if j == 0 else [""] * len(names), fontsize=7)
+            ax.invert_yaxis()
+            ax.set_title(f"{field.replace('marschner_lobb', 'Marschner-Lobb')}, {region}, n = {n}\n{label}", fontsize=8)
+            ax.grid(True, axis="x", which="both", alpha=0.3)
+    fig.suptitle("grey: what VTK uses (dashed: its value); blue: the paper's splines; green: prefiltered", fontsize=9)
     save_figure(fig, path)
 
 
