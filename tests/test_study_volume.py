@@ -113,12 +113,25 @@ def test_report_is_nan_free_json_and_markdown():
     assert "cubic scheme NOT available" in md and "### paper" in md
 
 
-def test_cli_knows_the_volume_study(capsys):
+def test_cli_runs_the_volume_study_runner_with_its_options(monkeypatch, tmp_path, capsys):
+    # `splinevis study volume --out DIR --quick` must call run_volume_study(DIR, quick=True, ...) and list what it
+    # wrote; a stand-in runner records the call (the real study takes minutes and is run by the sessions)
     from splinevis.cli import main
+    from splinevis.studies import volume as study_module
 
-    with pytest.raises(SystemExit) as exc:
-        main(["study", "volume", "--help"])
-    assert exc.value.code == 0
+    calls = []
+
+    def runner(out_dir, *, quick=False, progress=True):
+        calls.append((str(out_dir), quick, progress))
+        (tmp_path / "volume.md").write_text("# stand-in")
+        (tmp_path / "volume.json").write_text("{}")
+        return {"quick": quick}
+
+    monkeypatch.setattr(study_module, "run_volume_study", runner)
+    assert main(["study", "volume", "--out", str(tmp_path), "--quick", "--quiet"]) == 0
+    assert calls == [(str(tmp_path), True, False)]
+    out = capsys.readouterr().out
+    assert str(tmp_path / "volume.md") in out and str(tmp_path / "volume.json") in out
 
 
 def test_cubic_status_says_what_it_found(monkeypatch):
