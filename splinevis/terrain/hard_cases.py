@@ -128,7 +128,7 @@ def hard_cases() -> list:
     --------
     >>> cases = hard_cases()
     >>> len(cases), cases[0].name, cases[0].window_size, cases[5].clipping_range
-    (44, 'oblique', (400, 300), (0.001, 5.0))
+    (50, 'oblique', (400, 300), (0.001, 5.0))
     """
     size = (400, 300)
     grazing_z = 1.25
@@ -157,5 +157,5 @@ def hard_cases() -> list:
         HardCase("fractal-2048-steep", _steep_fractal, [(-600.0, -900.0, 4000.0), (1024.0, 1024.0, 900.0), (0, 0, 1)],
                  size, min_hits=0.05),
     ] + [HardCase(f"{kind}-{scheme}-{view}", functools.partial(_relief, kind, scheme), camera, size, min_hits=0.05)
-         for kind in ("crater", "cliff") for scheme in ("linear", "C0", "C1", "C2", "C2-cubic")
+         for kind in ("crater", "cliff") for scheme in ("linear", "C0", "C1", "C2", "C2-cubic", "C2-interp")
          for view, camera in RELIEF_VIEWS.items()]
