@@ -239,6 +239,21 @@ class VolumeSpline:
         """
         return self.grid.value_range
 
+    @property
+    def data_range(self) -> tuple:
+        """``(min, max)`` of the padded data the scheme reads: the samples, the extrapolated layer and, when
+        prefiltered, the prefiltered values (what float32 rounding of the data texture scales with; it can
+        exceed :attr:`value_range`).
+
+        >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
+        >>> VolumeSpline(x).value_range, VolumeSpline(x).data_range  # the padding extrapolates to -1 and 4
+        ((0.0, 3.0), (-1.0, 4.0))
+        """
+        r = getattr(self, "_data_range", None)
+        if r is None:
+            r = self._data_range = (float(self.padded.min()), float(self.padded.max()))
+        return r
+
     # ------------------------------------------------------------------ coefficients
     def stencil_data(self, cubes) -> np.ndarray:
         """(n, 27) padded data of the cubes' 27-point stencils (cubes as (n, 3) ``(i, j, k)``).
@@ -428,7 +443,8 @@ class VolumeSpline:
         Wd, tmap = self._distinct_weights()
         Wd32 = Wd.astype(np.float32)
         ref = 0.5 * (self.value_range[0] + self.value_range[1])
-        F = max(abs(self.value_range[0] - ref), abs(self.value_range[1] - ref), abs(iso - ref))
+        lo, hi = self.data_range  # the stencil reads padded (and prefiltered) data, not only the samples
+        F = max(abs(lo - ref), abs(hi - ref), abs(iso - ref))
         delta = np.float32(2 * 28 * 2.0**-24 * (1 + 2 * _negative_mass(self.weights)) * max(F, 1e-300))
         iso32 = np.float32(iso - ref)
         a32, b32 = iso32 - delta, iso32 + delta

@@ -239,7 +239,7 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
         matrix = np.asarray(matrix, dtype=np.float64) @ W
         origins, directions = _lattice_rays(model, origins, directions)
     off = sp.origin
-    lo, hi = sp.value_range
+    lo, hi = sp.data_range  # the texture holds the padded (and prefiltered) data
     ref = value_reference(sp)
     scale = max(abs(hi - ref), abs(lo - ref), abs(model.isovalue - ref))
     b = np.array(sp.bounds).reshape(3, 2) - off[:, None]
