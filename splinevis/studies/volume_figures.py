@@ -134,11 +134,17 @@ def pareto_figure(rows, setup, path):
     b'PNG'
     """
     plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
+    fig, axes = plt.subplots(1, 3, figsize=(20, 5.8))
     styles = {"MC skimage": ("k", "o"), "MC flying_edges": ("0.5", "s"), "VTK volume": ("tab:green", "^"),
               "quadratic spline": ("tab:blue", "D"), "cubic spline": ("tab:red", "v")}
+    # the prefiltered splines (method "quadratic spline (local prefilter, ...)"): one series each, lighter colours
+    extra = {"quadratic": ["tab:cyan", "deepskyblue"], "cubic": ["tab:orange", "tab:purple", "tab:pink"]}
+    for m in dict.fromkeys(r["method"] for r in rows):
+        if m not in styles and m.split(" spline")[0] in extra and extra[m.split(" spline")[0]]:
+            styles[m] = (extra[m.split(" spline")[0]].pop(0), "D" if m.startswith("quadratic") else "v")
     for key, (ykey, ylabel) in enumerate((("normal_err_median_deg", "median normal error (degrees)"),
-                                          ("coverage_mismatch", "coverage mismatch (pixels) + 1"))):
+                                          ("coverage_mismatch", "coverage mismatch (pixels) + 1"),
+                                          ("position_err_median_h", "median position error (grid spacings h)"))):
         ax = axes[key]
         for method, (col, mk) in styles.items():
             rs = [r for r in rows if r["method"] == method and r.get(ykey) is not None]
