@@ -190,13 +190,17 @@ def _level_padded(store, L, cubes):
     """Padded data of level ``L`` over the level cubes ``cubes`` (3 slices): the samples with the layer of
     neighbouring samples around them inside the level's volume, linear extrapolation at its border."""
     from ..volume import schemes
+    from ..volume.stencil import PADDINGS
 
     s, n = 1 << L, _level_cubes(store, L)
     ext = [(max(q.start - 1, 0), min(q.stop + 1, m)) for q, m in zip(cubes, n)]
     E = store.padded[1 + s * ext[0][0]:1 + s * (ext[0][1] - 1) + 1:s,
                      1 + s * ext[1][0]:1 + s * (ext[1][1] - 1) + 1:s,
                      1 + s * ext[2][0]:1 + s * (ext[2][1] - 1) + 1:s]
-    P = schemes._pad(E)  # extrapolated on every side; kept only where the window meets the border
+    # extrapolated on every side with the store's padding (linear where the level has too few samples for it);
+    # kept only where the window meets the border
+    padding = getattr(store, "padding", "linear")
+    P = schemes._pad(E, padding if min(E.shape) >= len(PADDINGS[padding]) else "linear")
     sl = tuple(slice(q.start - e0, q.stop - e0 + 2) for q, (e0, _) in zip(cubes, ext))
     return np.ascontiguousarray(P[sl])
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..volume.model import _box3, _negative_mass
 from ..volume.schemes import STENCIL, _check_scheme, _point_weights, _tet_weights
+from ..volume.stencil import PADDINGS, check_padding
 from .halo import _check_tile, _pad_axis_lazy, _sample_chunks, _window_map, _window_read, as_dask_array, tile_chunks
 
 __all__ = ["padded_volume_dask", "volume_coefficients_dask", "volume_cube_ranges_dask", "volume_input_chunks"]
@@ -36,6 +37,27 @@ def _linear_pad(axis):
     return pad
 
 
+def _poly_pad(axis, padding):
+    """The one-layer extrapolation of :data:`splinevis.volume.stencil.PADDINGS` along ``axis``, with the
+    arithmetic of :func:`splinevis.volume.stencil._pad` (same values, bit for bit)."""
+    if padding == "linear":
+        return _linear_pad(axis)
+    w = PADDINGS[padding]
+
+    def pad(b, lo, hi):
+        b = np.moveaxis(np.asarray(b, dtype=np.float64), axis, 0)
+        parts = ([sum(c * b[m] for m, c in enumerate(w))[None]] if lo else []) + [b] + \
+                ([sum(c * b[-1 - m] for m, c in enumerate(w))[None]] if hi else [])
+        return np.moveaxis(np.concatenate(parts, axis=0), 0, axis)
+    return pad
+
+
+def _pad_lazy(v, padding):
+    for ax in range(3):
+        v = _pad_axis_lazy(v, ax, 1, 1, len(PADDINGS[padding]), _poly_pad(ax, padding))
+    return v
+
+
 def _tiles3(chunks):
     t = (chunks,) * 3 if np.isscalar(chunks) else tuple(chunks)
     if len(t) != 3 or not all(isinstance(v, (int, np.integer)) and v > 0 for v in t):
@@ -46,14 +68,21 @@ def _tiles3(chunks):
     return tuple(int(v) for v in t)
 
 
-def padded_volume_dask(samples, *, chunks=64):
-    """The volume with its layer of linear extrapolation on every side, lazily (``pad_volume``'s values).
+def padded_volume_dask(samples, *, chunks=64, scheme="quadratic", prefilter="none", padding="linear"):
+    """The data a scheme reads, lazily: the volume (or, with ``prefilter="local"``, its local prefilter
+    ``2 f - K f`` of :mod:`splinevis.volume.prefilter`, which reads one more layer around each tile) with its
+    layer of extrapolation (``padding``) on every side; ``VolumeSpline(..., prefilter=, padding=).padded`` bit
+    for bit. ``prefilter="interpolate"`` is a global solve and is refused.
 
     Parameters
     ----------
     samples : (nz, ny, nx) dask array, zarr array, zarr path or array_like; >= 2 samples per axis
     chunks : int or (int, int, int)
         Chunks of the input when it is not a dask array yet.
+    scheme : {"quadratic", "cubic"}
+        Whose centre stencil the local prefilter inverts (ignored without a prefilter).
+    prefilter : {"none", "local"}
+    padding : {"linear", "quadratic", "cubic"}
 
     Returns
     -------
@@ -62,10 +91,23 @@ def padded_volume_dask(samples, *, chunks=64):
     Examples
     --------
     >>> from splinevis.volume.schemes import pad_volume
+    >>> from splinevis.volume.model import VolumeSpline
     >>> v = np.random.default_rng(2).random((5, 6, 7))
     >>> bool((padded_volume_dask(v, chunks=3).compute() == pad_volume(v)).all())
     True
+    >>> P = padded_volume_dask(v, chunks=3, scheme="cubic", prefilter="local", padding="quadratic").compute()
+    >>> bool((P == VolumeSpline(v, "cubic", prefilter="local", padding="quadratic").padded).all())
+    True
     """
+    from ..volume.prefilter import PREFILTERS, centre_kernel
+
+    if prefilter not in PREFILTERS:
+        raise ValueError(f"prefilter must be one of {PREFILTERS}, got {prefilter!r}.")
+    if prefilter == "interpolate":
+        raise ValueError("prefilter='interpolate' solves one linear system over the whole volume (every spline "
+                         "coefficient depends on every sample), so it is not built tile by tile. Use prefilter='local' "
+                         "(quadratics reproduced, values of order 3; one more halo layer) or build the spline in memory "
+                         "with VolumeSpline(..., prefilter='interpolate').")
     v = as_dask_array(samples, chunks=chunks)
     if v.ndim != 3:
         raise ValueError(f"samples must be a 3-D array of shape (nz, ny, nx); got {v.ndim}-D shape {v.shape}.")
@@ -73,9 +115,21 @@ def padded_volume_dask(samples, *, chunks=64):
         raise ValueError(f"samples must have at least 2 values along every axis (the border layer is "
                          f"extrapolated from two); got shape {v.shape}.")
     v = v.astype(np.float64)
-    for ax in range(3):
-        v = _pad_axis_lazy(v, ax, 1, 1, 2, _linear_pad(ax))
-    return v
+    check_padding(padding, v.shape)
+    if prefilter == "local":
+        # d = 2 f - K pad(f), the operations of prefilter.prefilter_data / centre_values in their order
+        P1 = _pad_lazy(v, padding)
+        K = centre_kernel(_check_scheme(scheme))
+        nz, ny, nx = v.shape
+        cv = None
+        for dz in range(3):
+            for dy in range(3):
+                for dx in range(3):
+                    if K[dz, dy, dx]:
+                        term = K[dz, dy, dx] * P1[dz:dz + nz, dy:dy + ny, dx:dx + nx]
+                        cv = (0.0 + term) if cv is None else cv + term
+        v = (2.0 * v - cv).rechunk(v.chunks)
+    return _pad_lazy(v, padding)
 
 
 def _cells3(v, chunks):
@@ -106,7 +160,7 @@ def _tile_chunks_list(shape, chunks):
     return [tile_chunks(n, t) for n, t in zip(shape, _tiles3(chunks))]
 
 
-def _tiled_padded(samples, chunks):
+def _tiled_padded(samples, chunks, **data_options):
     """``(padded, cells)``: the padded volume already cut into the tiles' sample chunks, and the tiles (data
     that is not a dask array yet is first cut by :func:`volume_input_chunks`)."""
     import dask.array as da
@@ -115,7 +169,7 @@ def _tiled_padded(samples, chunks):
     v = as_dask_array(samples)
     if not isinstance(samples, da.Array) and v.ndim == 3:
         v = v.rechunk(volume_input_chunks(v.shape, t))
-    P = padded_volume_dask(v)
+    P = padded_volume_dask(v, **data_options)
     cells = _cells3(v, chunks)
     return P.rechunk(tuple(_sample_chunks(c, 1, _HALO) for c in cells)), cells
 

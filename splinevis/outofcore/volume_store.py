@@ -32,7 +32,8 @@ _KIND = "splinevis volume store"
 
 
 def write_volume_store(path, samples, scheme="quadratic", *, chunks=64, spacing=(1.0, 1.0, 1.0),
-                       origin=(0.0, 0.0, 0.0), coefficients=False, compressor="lz4", progress=True):
+                       origin=(0.0, 0.0, 0.0), coefficients=False, compressor="lz4", progress=True,
+                       prefilter="none", padding="linear"):
     """Write a volume spline's padded data, its min-max octree and metadata (and, if asked, its coefficients).
 
     Parameters
@@ -50,6 +51,9 @@ def write_volume_store(path, samples, scheme="quadratic", *, chunks=64, spacing=
     compressor : {"lz4", "zstd", None}
         As for :func:`~.store.write_terrain_store`.
     progress : bool
+    prefilter, padding
+        As for :class:`~splinevis.volume.VolumeSpline`, except ``prefilter="interpolate"`` (a global solve:
+        refused); ``"local"`` reads one more sample layer around each tile.
 
     Returns
     -------
@@ -74,14 +78,14 @@ def write_volume_store(path, samples, scheme="quadratic", *, chunks=64, spacing=
     t = _tiles3(chunks)
     v = as_dask_array(samples)
     # one padded array, cut into the tiles' samples, feeds the stored data, the bounds and the coefficients
-    P, cells = _tiled_padded(samples, t)
+    P, cells = _tiled_padded(samples, t, scheme=scheme, prefilter=prefilter, padding=padding)
     _cube_ranges(P, cells, scheme)  # checks the tiles before anything is computed
     vmin, vmax = run(dask.delayed(tuple)([v.min(), v.max()]), progress=progress,
                      label="volume store: data range" if progress else "")
     group = zarr.open_group(str(path), mode="w")
     group.attrs.update({"kind": _KIND, "scheme": scheme, "spacing": [float(s) for s in spacing],
                         "origin": [float(o) for o in origin], "value_range": [float(vmin), float(vmax)],
-                        "shape": list(v.shape), "tile": list(t)})
+                        "shape": list(v.shape), "tile": list(t), "prefilter": prefilter, "padding": padding})
     codecs = _codecs(compressor)
     padded = group.create_array("padded", shape=P.shape, chunks=t, dtype="f8", compressors=codecs)
     # its chunks are the tiles' (the last one two samples longer): no two blocks write one zarr chunk
@@ -120,6 +124,8 @@ class VolumeStore:
     Attributes
     ----------
     scheme : str
+    prefilter, padding : str
+        What the stored padded data are (:class:`~splinevis.volume.VolumeSpline`'s options).
     spacing, origin : tuples of 3 floats
     shape : (nz, ny, nx) cubes
     tile : (int, int, int) cubes per tile
@@ -143,6 +149,8 @@ class VolumeStore:
         self.shape = tuple(int(v) for v in attrs["shape"])
         self.tile = tuple(int(v) for v in attrs["tile"])
         self.value_range = tuple(float(v) for v in attrs["value_range"])
+        self.prefilter = attrs.get("prefilter", "none")  # stores written before the option: the paper's scheme
+        self.padding = attrs.get("padding", "linear")
 
     @property
     def padded(self):
@@ -253,11 +261,15 @@ class VolumeStore:
                                         zip((k0, j0, i0), (k1, j1, i1), self.tile, self.shape)]
         P = self.padded[a0:a1 + 2, b0:b1 + 2, c0:c1 + 2]  # cube c's sample is padded[c + 1]
         org = tuple(o + c * d for o, c, d in zip(self.origin, (c0, b0, a0), self.spacing))
-        return VolumeSpline.from_padded(P, self.scheme, spacing=self.spacing, origin=org,
-                                        source=f"{self.path} tiles [{k0}:{k1}, {j0}:{j1}, {i0}:{i1}]")
+        w = VolumeSpline.from_padded(P, self.scheme, spacing=self.spacing, origin=org,
+                                     source=f"{self.path} tiles [{k0}:{k1}, {j0}:{j1}, {i0}:{i1}]")
+        w.prefilter = self.prefilter  # the padded data are the whole volume's (the window's own border is data)
+        return w
 
     def __repr__(self):
         nz, ny, nx = self.shape
         tz, ty, tx = self.tile
+        extra = "" if (self.prefilter, self.padding) == ("none", "linear") else \
+            f", prefilter={self.prefilter!r}, padding={self.padding!r}"
         return (f"VolumeStore(scheme={self.scheme!r}, cubes={nx}x{ny}x{nz}, tiles of {tx}x{ty}x{tz}, depth={self.depth}, "
-                f"value_range={self.value_range})")
+                f"value_range={self.value_range}{extra})")
