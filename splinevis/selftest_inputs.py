@@ -10,7 +10,7 @@ from math import comb
 import numpy as np
 
 
-__all__ = ["_eval_inputs", "_root_inputs", "_restrict_inputs", "_ROOT_KINDS"]
+__all__: list = []  # private helpers of splinevis.selftest (which re-exports them for the tests)
 
 def _power_to_bb(p):
     """Ascending power coefficients (..., n+1) -> BB coefficients: c_k = sum_{j<=k} C(k,j)/C(n,j) p_j."""

@@ -53,8 +53,11 @@ case "$job" in
     selftest) .venv/bin/splinevis selftest --out "${1:-out}" ;;
     bench) .venv/bin/python benchmarks/run.py "$@" ;;
     test)
+        # two pytest workers (pytest-xdist): most tests run one core (the float64 twins, numpy), so the suite
+        # takes about half the time on the 2-core CI machine; tests are balanced by work stealing (the slowest
+        # GPU hard cases would otherwise queue at the end of one worker). Arguments are passed on to pytest.
         set +e
-        .venv/bin/python -m pytest "$@"
+        .venv/bin/python -m pytest -n "${SPLINEVIS_TEST_WORKERS:-2}" --dist worksteal "$@"
         rc=$?
         set -e
         if [ "$rc" -eq 5 ]; then

@@ -445,7 +445,18 @@ def _write_pareto(out, result):
 def write_accuracy(out, result, sizes):
     """The accuracy table, its orders and ratios to linear: ``result["accuracy"]``, ``["accuracy_orders"]``,
     ``["accuracy_vs_linear"]`` and ``out/accuracy_table.md`` (``splinevis study terrain`` calls it; alone it
-    takes a few seconds: ``write_accuracy(dir, {}, (13, 25, 49))``)."""
+    takes a few seconds: ``write_accuracy(dir, {}, (13, 25, 49))``).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     result = {}
+    ...     write_accuracy(d, result, (5, 9))
+    ...     md = (Path(d) / "accuracy_table.md").read_text()
+    >>> sorted(result), "C2-interp" in md
+    (['accuracy', 'accuracy_orders', 'accuracy_vs_linear'], True)
+    """
     out = Path(out)
     result["accuracy"] = accuracy_table(sizes=sizes, sites=100_000)
     result["accuracy_orders"], result["accuracy_vs_linear"] = accuracy_orders(result["accuracy"])
