@@ -99,11 +99,9 @@ def padded_volume_dask(samples, *, chunks=64, scheme="quadratic", prefilter="non
     >>> bool((P == VolumeSpline(v, "cubic", prefilter="local", padding="quadratic").padded).all())
     True
     """
-    from ..volume.prefilter import PREFILTERS, centre_kernel
+    from ..volume.prefilter import centre_kernel, check_prefilter
 
-    if prefilter not in PREFILTERS:
-        raise ValueError(f"prefilter must be one of {PREFILTERS}, got {prefilter!r}.")
-    if prefilter == "interpolate":
+    if check_prefilter(prefilter) == "interpolate":
         raise ValueError("prefilter='interpolate' solves one linear system over the whole volume (every spline "
                          "coefficient depends on every sample), so it is not built tile by tile. Use prefilter='local' "
                          "(quadratics reproduced, values of order 3; one more halo layer) or build the spline in memory "

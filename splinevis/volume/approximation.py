@@ -89,6 +89,14 @@ def _check_size(n):
     return int(n)
 
 
+def _check_method(name):
+    try:
+        return parse_method(name)
+    except ValueError:
+        raise ValueError(f"scheme {name!r} is not known; choose one of {ALL_SCHEMES} or a method of parse_method "
+                         f"(e.g. {FIDELITY_METHODS[-1]!r}).") from None
+
+
 def sample_field(field, n: int) -> np.ndarray:
     """Samples ``volume[k, j, i] = field.value((x_i, y_j, z_k))`` on the ``n^3`` grid spanning the bounds.
 
@@ -222,11 +230,7 @@ def scheme_errors(field, n: int, scheme: str, points, *, relative: bool = False,
     >>> bool(scheme_errors(Square(), 11, "trilinear", points)["gradient_max"] > 0.05)
     True
     """
-    try:
-        parse_method(scheme)
-    except ValueError:
-        raise ValueError(f"scheme {scheme!r} is not known; choose one of {ALL_SCHEMES} or a method of "
-                         f"parse_method (e.g. {FIDELITY_METHODS[-1]!r}).") from None
+    _check_method(scheme)
     n = _check_size(n)
     p = as_float64_array(points, "points", shape_tail=(3,)).reshape(-1, 3)
     vol = sample_field(field, n) if volume is None else volume
@@ -273,11 +277,7 @@ def approximation_table(field, sizes=(16, 32, 64, 128), schemes=ALL_SCHEMES, n_p
     """
     sizes = sorted(_check_size(n) for n in sizes)
     for s in schemes:
-        try:
-            parse_method(s)
-        except ValueError:
-            raise ValueError(f"scheme {s!r} is not known; choose from {ALL_SCHEMES} or a method of parse_method "
-                             f"(e.g. {FIDELITY_METHODS[-1]!r}).") from None
+        _check_method(s)
     pts = evaluation_points(field, n_points, sizes[0], seed, region=region)
     rows = {s: [] for s in schemes}
     for n in sizes:

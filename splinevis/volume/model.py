@@ -21,6 +21,7 @@ from ..io.volumes import VolumeGrid
 from . import schemes as _schemes
 from ..hierarchy.pyramid import MinMaxPyramid
 from .partition import NUM_TETS, _bary_mats, _locate
+from .prefilter import _padded
 
 __all__ = ["VolumeSpline", "Relevant", "tet_weights", "SCHEME_DEGREE", "MIN_SAMPLES"]
 
@@ -145,15 +146,10 @@ class VolumeSpline:
         self.ncoef = self.weights.shape[1]
         self.prefilter, self.padding = prefilter, padding
         t0 = time.perf_counter()
-        if prefilter == "none" and padding == "linear":
-            self.padded = _schemes._pad(grid.values)  # the grid is validated already
-        else:
-            from .prefilter import padded_data
-
-            try:
-                self.padded = padded_data(grid.values, scheme, prefilter, padding)
-            except ValueError as e:
-                raise ValueError(f"{grid.source}: {e}") from None
+        try:
+            self.padded = _padded(grid.values, scheme, prefilter, padding)  # the grid is validated already
+        except ValueError as e:
+            raise ValueError(f"{grid.source}: {e}") from None
         self._octree = None
         self.setup_seconds = time.perf_counter() - t0
 

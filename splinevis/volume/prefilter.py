@@ -55,7 +55,7 @@ import numpy as np
 
 from .stencil import STENCIL, _check_volume, _pad, _stored_weights, check_padding
 
-__all__ = ["PREFILTERS", "centre_kernel", "centre_symbol", "centre_values", "prefilter_data", "padded_data"]
+__all__ = ["PREFILTERS", "check_prefilter", "centre_kernel", "centre_symbol", "centre_values", "prefilter_data", "padded_data"]
 
 #: Prefilters of the samples: the paper's plain scheme, the local quadratic-reproducing correction, and
 #: interpolation (cubic scheme only).
@@ -123,9 +123,19 @@ def centre_values(padded, scheme: str) -> np.ndarray:
     return out
 
 
-def _check(scheme, prefilter, padding, shape):
+def check_prefilter(prefilter) -> str:
+    """``prefilter`` if it is one of :data:`PREFILTERS`, else ValueError.
+
+    >>> check_prefilter("local")
+    'local'
+    """
     if prefilter not in PREFILTERS:
         raise ValueError(f"prefilter must be one of {PREFILTERS}, got {prefilter!r}.")
+    return prefilter
+
+
+def _check(scheme, prefilter, padding, shape):
+    check_prefilter(prefilter)
     if prefilter == "interpolate" and scheme == "quadratic":
         raise ValueError(
             "prefilter='interpolate' needs scheme='cubic': the quadratic super spline's value at a data point, "
@@ -209,7 +219,12 @@ def padded_data(values, scheme: str, prefilter: str = "none", padding: str = "li
     >>> padded_data(x, "quadratic").shape, float(padded_data(x, "quadratic")[1, 1, 0])  # linear padding
     ((6, 6, 6), -1.0)
     """
-    f = _check_volume(values)
+    return _padded(_check_volume(values), scheme, prefilter, padding, **options)
+
+
+def _padded(f, scheme, prefilter, padding, **options):
+    """:func:`padded_data` of a volume already checked (finite float64 3-D); the paper's case is exactly
+    :func:`splinevis.volume.stencil._pad`."""
     _check(scheme, prefilter, padding, f.shape)
     d = f if prefilter == "none" else prefilter_data(f, scheme, prefilter, padding, **options)
     return _pad(d, padding)

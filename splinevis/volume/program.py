@@ -242,11 +242,11 @@ def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) ->
     lo, hi = sp.data_range  # the texture holds the padded (and prefiltered) data
     ref = value_reference(sp)
     scale = max(abs(hi - ref), abs(lo - ref), abs(model.isovalue - ref))
-    b = np.array(sp.bounds).reshape(3, 2) - off[:, None]
+    box = np.array(sp.bounds).reshape(3, 2)
+    b = box - off[:, None]
     # the bound's slope steps t +- 1e-6 |t| along the ray; for a hit on a face of the domain (an isosurface cut
     # by the volume's boundary) that step leaves the domain: it is clamped to it (a one-sided difference there)
-    lo_b, hi_b = np.array(sp.bounds)[0::2], np.array(sp.bounds)[1::2]
-    return isosurface_depth_error_bound(lambda q: sp.evaluate(np.clip(q + off, lo_b, hi_b), gradient=True), scale,
+    return isosurface_depth_error_bound(lambda q: sp.evaluate(np.clip(q + off, box[:, 0], box[:, 1]), gradient=True), scale,
                                         sp.spacing,
                                         model_frame_matrix(matrix, off), np.asarray(origins) - off, directions, t,
                                         float(np.abs(b).max()), sp.degree)

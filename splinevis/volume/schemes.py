@@ -525,13 +525,9 @@ def evaluate_volume(volume, points, scheme: str, *, gradient: bool = False, tol:
     cell, local = _check_points(p, vol.shape, tol)
     flat = cell.reshape(-1, 3)
     uniq, inv = np.unique(flat, axis=0, return_inverse=True)
-    if prefilter == "none" and padding == "linear":
-        P = _pad(vol)
-    else:
-        from .prefilter import padded_data
+    from .prefilter import _padded
 
-        P = padded_data(vol, scheme, prefilter, padding)
-    coefs = _cube_coefficients(P, uniq, scheme)  # (u, 24, m)
+    coefs = _cube_coefficients(_padded(vol, scheme, prefilter, padding), uniq, scheme)  # (u, 24, m)
     t, lam = _locate(local)
     cc = coefs[inv.reshape(cell.shape[:-1]), t]
     return _eval_patch(cc, t, lam, gradient)
