@@ -1,6 +1,7 @@
 """The stored scheme weights (splinevis/terrain/_c1_weights.py, splinevis/volume/_scheme_weights.py, written by
-tools/gen_scheme_weights.py) are the derivations' results to the bit, the generated files are current, and
-building splines reads them without any linear algebra.
+tools/gen_scheme_weights.py) are the derivations' results to the bit (the C1 terrain weights solved in exact
+rational arithmetic, tools/exact_linalg.py), the generated files are current, and building splines reads them
+without any linear algebra.
 """
 
 from __future__ import annotations
@@ -40,11 +41,11 @@ def _bits(a):
 
 
 def _c1_forward_bound():
-    """Forward error bound of the least-norm solve of the C1 system, ``sqrt(N) u kappa max|W|``: the
+    """Forward error bound of the float64 least-norm solve of the C1 system, ``sqrt(N) u kappa max|W|``: the
     first-order perturbation bound of a consistent least-squares problem (residual 0), ``|dx| / |x| <= p u
     kappa`` with kappa = s_max / s_rank of the system, and p = sqrt(N) (N unknowns) for the backward error of
-    an SVD-based solver. The last bits of the solution depend on the BLAS kernels (an AVX-512 machine
-    differs from an AVX2 one by ~8 units in the last place), so the stored floats are compared within this."""
+    an SVD-based solver. The last bits of the float64 solution depend on the BLAS kernels (an AVX-512 machine
+    differs from an AVX2 one by ~8 units in the last place), so it is compared with the exact one within this."""
     A, _, _ = c1_scheme.c1_system()
     rank = c1_scheme._c1_solution()[1]["rank"]
     s = np.linalg.svd(A, compute_uv=False)
@@ -52,10 +53,22 @@ def _c1_forward_bound():
     return np.sqrt(A.shape[1]) * np.finfo(float).eps / 2 * (s[0] / s[rank - 1]) * np.abs(stored).max()
 
 
-def test_stored_c1_terrain_weights_are_the_derivation(derived):
+def test_stored_c1_terrain_weights_are_the_exact_derivation(derived):
     stored = np.array(C1_FLOATS, dtype=np.float64)
     assert stored.shape == (len(c1_scheme.C1_STENCIL), 30)
-    assert np.abs(stored - derived["C1"]).max() <= _c1_forward_bound()
+    # the stored floats are the correctly rounded exact least-norm weights, to the bit
+    exact = _generator().exact_c1()
+    assert np.array_equal(_bits(stored), _bits([[float(q) for q in row] for row in exact]))
+    assert np.array_equal(_bits(stored), _bits(derived["C1"]))
+    # the exact weights satisfy the C1 and cubic-reproduction rows exactly (the system's entries are the
+    # fractions of denominator <= 12 that its float64 entries round)
+    A, rhs, _ = c1_scheme.c1_system()
+    x = [q for row in exact for q in row]
+    for r in np.random.default_rng(0).choice(A.shape[0], 40, replace=False):
+        row = [Fraction(float(v)).limit_denominator(12) for v in A[r]]
+        assert sum(a * b for a, b in zip(row, x) if a) == Fraction(float(rhs[r])).limit_denominator(12)
+    # the float64 solve agrees within its forward error bound
+    assert np.abs(stored - c1_scheme._c1_solution()[0]).max() <= _c1_forward_bound()
     # the scheme's window holds exactly these rows at the stencil's offsets, zeros elsewhere
     st = c1_scheme._c1()
     offs = [(st.x0 + b, st.y0 + a) for a in range(st.kh) for b in range(st.kw)]
@@ -82,12 +95,7 @@ def test_stored_volume_weights_are_exact_fractions_equal_to_the_derivation(deriv
 
 
 def test_generated_weight_modules_are_current(derived):
-    # the C1 floats are the derivation within its forward bound (test above); the file must be the generator's
-    # text of the stored floats, the volume fractions the derivation's exactly
-    tables = dict(derived)
-    assert np.abs(np.array(C1_FLOATS) - derived["C1"]).max() <= _c1_forward_bound()
-    tables["C1"] = np.array(C1_FLOATS, dtype=np.float64)
-    for rel, text in _generator().generate(tables).items():
+    for rel, text in _generator().generate(derived).items():
         assert (ROOT / rel).read_text() == text, f"run python tools/gen_scheme_weights.py ({rel} is stale)"
 
 

@@ -98,6 +98,9 @@ def _bary_mats() -> np.ndarray:
     v = _tets()
     m = np.concatenate([v, np.ones((NUM_TETS, 4, 1))], axis=2)  # rows (x, y, z, 1) per vertex
     inv = np.linalg.inv(np.swapaxes(m, 1, 2))  # lam = inv @ (x, y, z, 1)
+    # the entries are integers (vertices at 0, 1/2, 1): snap away the LAPACK kernel's rounding, so every machine
+    # gets the same bits (and no negative zeros)
+    inv = np.round(inv) + 0.0
     inv.setflags(write=False)
     return inv
 
