@@ -4,7 +4,7 @@ The generators (tools/gen_volume_glsl.py, tools/gen_scheme_weights.py, tools/gen
 fresh processes under OpenBLAS core types other than this machine's own (``OPENBLAS_CORETYPE``; OpenBLAS picks
 its kernels at run time, and float64 solves differ in their last bits between them) and with 1 and 2 threads,
 and their output is compared with the committed files. A generated number that came from a float64 solve
-would differ between kernels; the generators solve in exact rational arithmetic (tools/exact_linalg.py) or snap
+would differ between kernels; the generators solve in exact rational arithmetic (splinevis/_exact.py) or snap
 to exact fractions with a derived margin, so nothing may move. The core type actually used is read back
 (threadpoolctl) so a run that silently kept the default kernels cannot pass for another.
 """

@@ -1,6 +1,6 @@
 """The stored scheme weights (splinevis/terrain/_c1_weights.py, splinevis/volume/_scheme_weights.py, written by
 tools/gen_scheme_weights.py) are the derivations' results to the bit (the C1 terrain weights solved in exact
-rational arithmetic, tools/exact_linalg.py), the generated files are current, and building splines reads them
+rational arithmetic, splinevis/_exact.py), the generated files are current, and building splines reads them
 without any linear algebra.
 """
 
@@ -111,7 +111,7 @@ def boom(*args, **kwargs):
     raise AssertionError("a scheme derivation / solver ran while building a spline")
 
 for mod, names in [(np.linalg, ["lstsq", "solve", "svd", "matrix_rank", "pinv"]),
-                   (c1, ["_c1_solution", "c1_system"]), (vs, ["_weights", "_solve_block"]), (vc, ["_weights"])]:
+                   (c1, ["_c1_solution", "c1_system"]), (vs, ["_weights"]), (vc, ["_weights"])]:
     for name in names:
         setattr(mod, name, boom)
 rng = np.random.default_rng(0)

@@ -16,6 +16,7 @@ TINY = {"main": ("teapot", 4), "main_delta": 0.1, "small": ("teapot", 1), "delta
         "hull": ("hull", 60), "hull_delta": 0.02, "frames": 8, "pixel_errors": (1.0, 4.0),
         "simplify": ("hull_noportholes", 300), "simplify_delta": 0.01, "simplify_samples": 12, "repeats": 1,
         "occ_step": 4.0, "cad_copies": 1, "cad_delta": 0.02}
+SMALL_WINDOW = (320, 240)
 
 
 @pytest.fixture(scope="module")
@@ -23,6 +24,8 @@ def run(tmp_path_factory):
     out = tmp_path_factory.mktemp("walkthrough")
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(W, "_settings", lambda quick: dict(TINY))
+        for module in (W, C):  # a smaller window: the same code path, a sixth of the pixels to render
+            mp.setattr(module, "WINDOW", SMALL_WINDOW)
         result = W.run_walkthrough_study(out, quick=True, progress=False)
     return out, result
 
@@ -31,6 +34,7 @@ def test_json_and_markdown_have_the_new_sections(run):
     out, result = run
     data = json.loads((out / "walkthrough.json").read_text())
     assert data == result
+    assert data["window"] == list(SMALL_WINDOW)
     b, e = data["lod_vs_meshes"], data["simplification"]
     assert set(b) >= {"delta", "levels", "uniform", "occ", "occ_available", "matches"}
     assert len(b["levels"]) == len(b["matches"]) == 4

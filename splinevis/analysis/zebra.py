@@ -9,10 +9,13 @@ import numpy as np
 __all__ = ["zebra_reference"]
 
 
-def zebra_reference(model, matrix, window, stripes: int, axis) -> tuple:
+def zebra_reference(model, matrix, window, stripes: int, axis, pixels=None) -> tuple:
     """``(bright, hit, edge_distance)`` per pixel of a ``window = (W, H)`` seen through ``matrix``: the exact
     stripe colour (True bright), the twin's hit mask, and each pixel's distance to the nearest stripe edge in
     stripe widths (both colours are right within rounding of an edge).
+
+    ``pixels`` (an ``(H, W)`` bool mask, optional) casts only those pixels' rays (the float64 twin costs per
+    ray); the others read as missed (``hit`` False, ``bright`` False, distance 0).
 
     Examples
     --------
@@ -22,6 +25,13 @@ def zebra_reference(model, matrix, window, stripes: int, axis) -> tuple:
     >>> bright, hit, edge = zebra_reference(QuarticTrianglePatch.demo(), np.eye(4), (8, 6), 4, (1, 0, 0))
     >>> bright.shape, int(hit.sum()), int((bright & hit).sum()), bool(edge[hit].max() <= 0.5)
     ((6, 8), 29, 11, True)
+
+    Only the left half of the pixels:
+
+    >>> left = np.zeros((6, 8), bool); left[:, :4] = True
+    >>> b2, h2, e2 = zebra_reference(QuarticTrianglePatch.demo(), np.eye(4), (8, 6), 4, (1, 0, 0), pixels=left)
+    >>> bool((h2 == (hit & left)).all() and (b2[left] == bright[left]).all() and not b2[~left].any())
+    True
     """
     from ..effects import line_frame
     from ..gl.camera import pixel_rays
@@ -29,6 +39,10 @@ def zebra_reference(model, matrix, window, stripes: int, axis) -> tuple:
 
     w, h = window
     o, d = pixel_rays(matrix, w, h)
+    mask = np.ones((h, w), bool) if pixels is None else np.asarray(pixels, dtype=bool)
+    if mask.shape != (h, w):
+        raise ValueError(f"pixels must be an (H, W) = {(h, w)} mask of the window, got shape {mask.shape}.")
+    o, d = o[mask], d[mask]
     hits = program_for(model).raycast(model, o, d, 0.0)
     rd = d / np.linalg.norm(d, axis=-1, keepdims=True)
     n = hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
@@ -37,4 +51,7 @@ def zebra_reference(model, matrix, window, stripes: int, axis) -> tuple:
     b, c = (np.asarray(v) for v in line_frame(axis))
     x = np.arctan2(r @ b, r @ c) / np.pi * stripes
     f = x - np.floor(x)
-    return f >= 0.5, hits.hit, np.minimum(np.abs(f - 0.5), np.minimum(f, 1 - f))
+    bright, hit, edge = np.zeros((h, w), bool), np.zeros((h, w), bool), np.zeros((h, w))
+    bright[mask], hit[mask] = f >= 0.5, hits.hit
+    edge[mask] = np.minimum(np.abs(f - 0.5), np.minimum(f, 1 - f))
+    return bright, hit, edge

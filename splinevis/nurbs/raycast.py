@@ -283,9 +283,13 @@ def _planes(d):
     return rd, n1, np.cross(rd, n1)
 
 
-def newton_on_rays(model, patch, uv, origins, directions, iterations: int):
+def newton_on_rays(model, patch, uv, origins, directions, iterations: int, *, settle: bool = False):
     """The fragment program's Newton in float64: ``iterations`` steps on F(u, v) = (n1 . (S - o), n2 . (S - o))
     from ``uv``, kept in each patch's domain (wrapped across closed seams, clamped at open edges).
+
+    ``settle=True`` (the float64 reference, not the shader's twin): a ray stops once a step moves neither
+    parameter by more than 4 eps of its size (the iterate is a fixed point up to rounding; further steps
+    only dither it by rounding), so converged rays do not pay for the remaining steps.
 
     ``origins`` are model-frame (world minus :func:`model_offset`). Returns ``uv (n, 2)``, the residual |F|
     ``(n,)`` and ``derivatives (n, 2, 2, 3)`` (S, S_u, S_v with S model frame) at the result.
@@ -313,17 +317,24 @@ def newton_on_rays(model, patch, uv, origins, directions, iterations: int):
         closed, poles, tables = facts[k]["closed"], facts[k]["poles"], facts[k]["pole_tables"]
         x = _into_domain(s, closed, uv[sel])
         a1, a2, oo = n1[sel], n2[sel], o[sel]
+        live = np.arange(len(sel))  # rays still iterating (all of them unless settle)
         for _ in range(iterations):
-            d = s.derivatives(x[:, 0], x[:, 1], 1)
-            e = d[:, 0, 0] - off - oo
-            F = np.stack([np.einsum("ij,ij->i", a1, e), np.einsum("ij,ij->i", a2, e)], axis=-1)
-            j11, j12 = np.einsum("ij,ij->i", a1, d[:, 1, 0]), np.einsum("ij,ij->i", a1, d[:, 0, 1])
-            j21, j22 = np.einsum("ij,ij->i", a2, d[:, 1, 0]), np.einsum("ij,ij->i", a2, d[:, 0, 1])
+            if not live.size:
+                break
+            xl, b1, b2 = x[live], a1[live], a2[live]
+            d = s.derivatives(xl[:, 0], xl[:, 1], 1)
+            e = d[:, 0, 0] - off - oo[live]
+            F = np.stack([np.einsum("ij,ij->i", b1, e), np.einsum("ij,ij->i", b2, e)], axis=-1)
+            j11, j12 = np.einsum("ij,ij->i", b1, d[:, 1, 0]), np.einsum("ij,ij->i", b1, d[:, 0, 1])
+            j21, j22 = np.einsum("ij,ij->i", b2, d[:, 1, 0]), np.einsum("ij,ij->i", b2, d[:, 0, 1])
             det = j11 * j22 - j12 * j21
             ok = det != 0
             safe = np.where(ok, det, 1.0)
             step = np.stack([j22 * F[:, 0] - j12 * F[:, 1], -j21 * F[:, 0] + j11 * F[:, 1]], axis=-1) / safe[:, None]
-            x = np.where(ok[:, None], _step(s, closed, poles, x, step, tables), x)
+            x[live] = np.where(ok[:, None], _step(s, closed, poles, xl, step, tables), xl)
+            if settle:
+                moved = np.abs(x[live] - xl) > 4 * np.finfo(np.float64).eps * np.maximum(np.abs(xl), 1.0)
+                live = live[ok & moved.any(axis=1)]
         d = s.derivatives(x[:, 0], x[:, 1], 1)
         d[:, 0, 0] -= off
         e = d[:, 0, 0] - oo
@@ -406,7 +417,7 @@ def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
     r, ti, b1, b2 = _ray_triangles(o, d, pts[tris])
     uv0 = (1 - b1 - b2)[:, None] * uvs[tris[ti, 0]] + b1[:, None] * uvs[tris[ti, 1]] + b2[:, None] * uvs[tris[ti, 2]]
     pid = ids[tris[ti, 0]].astype(int)
-    uv, res, der = newton_on_rays(m, pid, uv0, o[r], d[r], iterations)
+    uv, res, der = newton_on_rays(m, pid, uv0, o[r], d[r], iterations, settle=not gpu)
     S = der[:, 0, 0]
     t = np.einsum("ij,ij->i", S - o[r], d[r]) / np.einsum("ij,ij->i", d[r], d[r])
     if gpu:

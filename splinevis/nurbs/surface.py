@@ -225,8 +225,10 @@ class NurbsSurface:
         iu = su[:, None] - p + np.arange(p + 1)  # (m, p+1)
         iv = sv[:, None] - q + np.arange(q + 1)
         net = Pw[iu[:, :, None], iv[:, None, :]]  # (m, p+1, q+1, 4)
-        # A^(k,l) = sum_a sum_b N_u^(k)[a] N_v^(l)[b] Pw[a, b]
-        return np.einsum("mka,mlb,mabc->mklc", Nu, Nv, net)
+        # A^(k,l) = sum_a N_u^(k)[a] (sum_b N_v^(l)[b] Pw[a, b]): two contractions (a third of the products of
+        # the one three-operand sum; numpy's own loops, not BLAS, so the bits do not follow the BLAS kernels)
+        rows = np.einsum("mlb,mabc->malc", Nv, net)
+        return np.einsum("mka,malc->mklc", Nu, rows)
 
 
 def _unit_normal(SKL: np.ndarray, with_mask: bool = False):

@@ -25,8 +25,8 @@ Determining set and the remaining coefficients
 The 20 domain points on the cube's edges get data averages: a cube vertex (surrounded by 8 grid points)
 gets the mean of those 8 values, an edge midpoint the mean of the 4 grid values around the edge. Both are
 exact for linear ``f``.  The other 45 coefficients are fixed linear combinations of the cube's 27-point
-data stencil, derived by :func:`derive_weights` (linear algebra, float64, then snapped to the exact
-multiples of 1/16 they turn out to be; the package reads them as exact fractions from
+data stencil, derived by :func:`derive_weights` (exact rational linear algebra, :mod:`splinevis._exact`; they turn out
+to be multiples of 1/16; the package reads them as exact fractions from
 :mod:`splinevis.volume._scheme_weights`, written by ``tools/gen_scheme_weights.py`` from this derivation):
 
 1. the 30 coefficients on the cube's boundary faces (``wF`` and ``(wF + u)/2``) from the C1 conditions
@@ -149,17 +149,6 @@ def _face_conditions():
     return np.array(rows)
 
 
-def _solve_block(A, known, unknown, name):
-    """W with x_unknown = W @ x_known minimizing |A x|; refuse rank deficiency."""
-    Au, Ak = A[:, unknown], A[:, known]
-    rank = np.linalg.matrix_rank(Au)
-    if rank < len(unknown):
-        raise RuntimeError(f"{name}: the smoothness conditions do not determine the {len(unknown)} coefficients "
-                           f"(rank {rank}).")
-    W, *_ = np.linalg.lstsq(Au, -Ak, rcond=None)
-    return W
-
-
 def _edge_data_weights():
     """(20, 27) data weights of the edge coefficients (cube centred at the data point 0)."""
     pts = _domain()[0][edge_points()]
@@ -174,15 +163,17 @@ def _edge_data_weights():
     return E
 
 
-def _snap(w):
-    """The derived weights are multiples of 1/16: remove the solvers' rounding noise (only if tiny)."""
-    s = np.round(w * 2.0**10) / 2.0**10 + 0.0  # no negative zeros
-    return s if np.abs(s - w).max() < 1e-9 else w
-
-
 @functools.lru_cache(maxsize=None)
 def _weights():
-    """Derivation (see the module docstring and docs/volume-schemes.md). Returns (W (65, 27), diagnostics)."""
+    """Derivation (see the module docstring and docs/volume-schemes.md), in exact rational arithmetic
+    (:mod:`splinevis._exact`): every decision of the greedy step 2 is an exact consistency test, so the result
+    does not depend on the machine's BLAS (decided in float64 it did: one OpenBLAS SkylakeX thread imposed 56
+    conditions instead of 84). Returns (W (65, 27) float64, exact conditions, pairs, face residual, hard residual);
+    the residuals are exact, hence 0.0."""
+    from .._exact import flint_module, lstsq_full_rank, nullspace, qmat, solve_any
+
+    flint = flint_module()
+    Q = flint.fmpq_mat
     n = NUM_DOMAIN_POINTS
     pts = _domain()[0]
     edge, face = edge_points(), _face_points()
@@ -190,14 +181,18 @@ def _weights():
     known = np.concatenate([edge, face])
     # 1. face coefficients from the criss-cross C1 conditions of each face (unique, consistent)
     F = _face_conditions()
-    Wf = _solve_block(F, edge, face, "face coefficients")
-    face_res = float(np.abs(F[:, face] @ Wf + F[:, edge]).max())
-    if face_res > 1e-13:
-        raise RuntimeError(f"face C1 conditions are inconsistent (residual {face_res:.3g}).")
-    E = _edge_data_weights()
-    K = np.zeros((n, 27))
-    K[edge] = E
-    K[face] = _snap(Wf @ E)
+    Fu, Fk = qmat(F[:, face], what="face condition"), qmat(F[:, edge], what="face condition")
+    if Fu.rank() < len(face):
+        raise RuntimeError(f"face coefficients: the smoothness conditions do not determine the {len(face)} "
+                           f"coefficients (rank {Fu.rank()}).")
+    Wf = lstsq_full_rank(Fu, -Fk)
+    if Fu * Wf + Fk != Q(Fk.nrows(), Fk.ncols()):
+        raise RuntimeError("face C1 conditions are inconsistent.")
+    Eq = qmat(_edge_data_weights(), what="edge data weight")
+    rows = {int(p): r for p, r in zip(edge, Eq.table())}
+    rows.update({int(p): r for p, r in zip(face, (Wf * Eq).table())})
+    zero27 = [flint.fmpq(0)] * 27
+    K = [rows.get(m, zero27) for m in range(n)]  # exact data weights of the known points (inner: zero)
     # 2. inner coefficients: unknown data weights X (15, 27), vector x = X.ravel()
     ni = len(inner)
     nx = ni * 27
@@ -208,6 +203,12 @@ def _weights():
         for j, o in enumerate(STENCIL):
             M[_BIG_ID[tuple(int(v) for v in o + shift)], iid[p] * 27 + j] = 1.0
         return M
+
+    def lifted(w27, factor=1):  # exact _lift(w, 0): weights on the 125 offsets -2..2
+        out = [flint.fmpq(0)] * 125
+        for j, b in enumerate(_S27):
+            out[int(b)] = factor * w27[j]
+        return out
 
     v = _tets()
     vq = np.full(3, 0.5)
@@ -223,62 +224,81 @@ def _weights():
             fp = _idx((wf + target) / 2)
             hard.append(inner_rows(_idx((vq + target) / 2), np.zeros(3, dtype=np.int64))
                         + inner_rows(_idx((vq + target - d) / 2), d))
-            hard_rhs.append(2 * _lift(K[fp], np.zeros(3, dtype=np.int64)))
+            hard_rhs += lifted(K[fp], 2)
     # (b) reproduction of linear functions
     for m, p in enumerate(inner):
         for mono in range(4):
             r = np.zeros((1, nx))
             r[0, m * 27:(m + 1) * 27] = 1.0 if mono == 0 else STENCIL[:, mono - 1]
             hard.append(r)
-            hard_rhs.append(np.array([1.0 if mono == 0 else pts[p][mono - 1] - 0.5]))
-    # (c) inner C1 conditions, as identities in the data
-    A, pairs = inner_face_conditions()
-    soft, soft_rhs = [], []
-    for r in range(A.shape[0]):
-        M = np.zeros((125, nx))
-        for m, p in enumerate(inner):
-            if A[r, p] != 0:
-                M[_S27, m * 27:(m + 1) * 27] += A[r, p] * np.eye(27)
-        soft.append(M)
-        soft_rhs.append(-_lift(A[r, known] @ K[known], np.zeros(3, dtype=np.int64)))
-    H, h = np.vstack(hard), np.concatenate(hard_rhs)
-    keep = np.abs(H).sum(axis=1) + np.abs(h) > 0
-    H, h = H[keep], h[keep]
-    x0, *_ = np.linalg.lstsq(H, h, rcond=None)
-    if np.abs(H @ x0 - h).max() > 1e-12:
+            hard_rhs.append(flint.fmpq(1) if mono == 0 else flint.fmpq(int(round(4 * (pts[p][mono - 1] - 0.5))), 4))
+    H = np.vstack(hard)
+    keep = [i for i in range(H.shape[0]) if np.abs(H[i]).sum() > 0 or hard_rhs[i] != 0]
+    Hq = qmat(H[keep], what="cube-face or reproduction condition")
+    hq = Q(len(keep), 1, [hard_rhs[i] for i in keep])
+    x0 = solve_any(Hq, hq)
+    if x0 is None:
         raise RuntimeError("cube-face C1 + linear reproduction is inconsistent: refusing.")
-    _, sv, vt = np.linalg.svd(H)
-    N = vt[int(np.sum(sv > 1e-10 * sv[0])):].T  # solutions: x0 + N y
+    N = nullspace(Hq)  # solutions: x0 + N y
+    # (c) inner C1 conditions, as identities in the data: condition r says sum_p A[r, p] c_p = 0; its 27 data
+    #     rows (the other 98 of the 125 offsets are 0 = 0): sum_m A[r, inner_m] X[m] = -sum_known A[r, k] K[k]
+    A, pairs = inner_face_conditions()
+    Aq = [[flint.fmpq(q.numerator, q.denominator) for q in row]
+          for row in np.array(_fractions(A), dtype=object).reshape(A.shape)]
+
+    def condition(r, basis, point):  # (R basis, rhs - R point) of condition r, 27 rows each
+        cols = basis.ncols()
+        btab, ptab = basis.table(), point.table()
+        RB, rhs = [], []
+        for j in range(27):
+            row = [flint.fmpq(0)] * cols
+            acc = -sum((Aq[r][k] * K[k][j] for k in known if Aq[r][k] != 0), flint.fmpq(0))
+            for m, p in enumerate(inner):
+                a = Aq[r][p]
+                if a != 0:
+                    brow = btab[m * 27 + j]
+                    row = [x + a * y for x, y in zip(row, brow)]
+                    acc -= a * ptab[m * 27 + j][0]
+            RB.append(row)
+            rhs.append(acc)
+        return Q(27, cols, [x for row in RB for x in row]), Q(27, 1, rhs)
+
     # greedily impose inner C1 conditions (in row order) that stay consistent with the imposed ones
     added = []
     for r in range(A.shape[0]):
-        R, b = soft[r], soft_rhs[r]
-        RN = R @ N
-        # the rank cut of every decision is 1e-10 (as for N): lstsq's default (eps * max(shape)) inverted a
-        # roundoff-sized singular value on AVX-512 OpenBLAS kernels and judged 16 consistent conditions inconsistent
-        y, *_ = np.linalg.lstsq(RN, b - R @ x0, rcond=1e-10)
-        if np.abs(RN @ y + R @ x0 - b).max() < 1e-10:
-            x0 = x0 + N @ y
-            _, sv, vt = np.linalg.svd(RN)
-            rk = int(np.sum(sv > 1e-10 * max(sv[0], 1.0))) if sv.size else 0
-            N = N @ vt[rk:].T
+        RN, b = condition(r, N, x0)
+        y = solve_any(RN, b) if N.ncols() else (Q(0, 1) if b == Q(27, 1) else None)
+        if y is not None:
+            if N.ncols():
+                x0 = x0 + N * y
+                N = N * nullspace(RN)
             added.append(r)
     rest = [r for r in range(A.shape[0]) if r not in added]
-    x = x0
-    if rest and N.shape[1]:  # least squares over the conditions that cannot hold ("averaging")
-        O = np.vstack([soft[r] for r in rest])
-        o = np.concatenate([soft_rhs[r] for r in rest])
-        y, *_ = np.linalg.lstsq(O @ N, o - O @ x0, rcond=None)
-        x = x0 + N @ y
-    x = _snap(x)
-    Hall = np.vstack([np.vstack(hard)] + [soft[r] for r in added])
-    hall = np.concatenate([np.concatenate(hard_rhs)] + [soft_rhs[r] for r in added])
-    W = K.copy()
-    W[inner] = x.reshape(ni, 27)
-    res = np.array([np.abs(soft[r] @ x - soft_rhs[r]).max() for r in range(A.shape[0])])
-    exact = res < 1e-10
+    x, Z = x0, N
+    if rest and N.ncols():  # least squares over the conditions that cannot hold ("averaging")
+        parts = [condition(r, N, x0) for r in rest]
+        ON = Q(27 * len(rest), N.ncols(), [v for RN, _ in parts for row in RN.table() for v in row])
+        o = Q(27 * len(rest), 1, [row[0] for _, b in parts for row in b.table()])
+        y = solve_any(ON.transpose() * ON, ON.transpose() * o)
+        x = x0 + N * y
+        Z = N * nullspace(ON)
+    if Z.ncols():  # the least-norm one among the solutions (what float64 lstsq and SVD null spaces gave)
+        x = x - Z * (Z.transpose() * Z).solve(Z.transpose() * x)
+    if Hq * x != hq:
+        raise RuntimeError("the derived inner weights break the imposed conditions.")
+    exact = np.array([condition(r, Q(nx, 0), x)[1] == Q(27, 1) for r in range(A.shape[0])])
+    if not exact[added].all():
+        raise RuntimeError("an imposed inner C1 condition does not hold for the derived weights.")
+    W = np.array([[float(q) for q in row] for row in K], dtype=np.float64)
+    W[inner] = np.array([float(q) for q in x.entries()]).reshape(ni, 27)
     W.setflags(write=False)
-    return W, exact, pairs, face_res, float(np.abs(Hall @ x - hall).max())
+    return W, exact, pairs, 0.0, 0.0
+
+
+def _fractions(a):
+    from .._exact import rationals
+
+    return rationals(a, what="inner C1 condition")
 
 
 def derive_weights() -> dict:

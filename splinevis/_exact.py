@@ -1,4 +1,5 @@
-"""Exact rational linear algebra for the generators of stored tables (tools/gen_*.py).
+"""Exact rational linear algebra for the derivations of stored tables (tools/gen_*.py and the quadratic volume
+scheme's :func:`splinevis.volume.schemes.derive_weights`).
 
 Why: a float64 solve's last bits follow the BLAS/LAPACK kernels of the machine (OpenBLAS picks Haswell, SkylakeX,
 Zen, ... kernels at run time), so a table printed from a float64 solve differs between machines in its last
@@ -6,7 +7,12 @@ digits, and a test comparing the committed text with the generator's output flip
 derivations' systems are rational, so their solutions are rational: solved here exactly (python-flint's
 ``fmpq_mat``, FLINT's fraction-free rational matrices; sympy's pure-Python ``DomainMatrix`` took 16 s for the
 volume system, FLINT well under one), and printed from the exact value (:func:`literal`: the shortest repr of
-the correctly rounded double), the generated text is the same bytes on every machine.
+the correctly rounded double), the generated text is the same bytes on every machine. A greedy derivation
+(impose a condition if it stays consistent) decided in float64 can even decide differently: the quadratic volume
+scheme's did under one OpenBLAS SkylakeX thread (56 instead of 84 exact conditions); decided exactly it cannot.
+No library of the stack offers exact consistency tests, particular solutions and null spaces on top of FLINT's
+``rref``; :func:`solve_any` and :func:`nullspace` are the two dozen lines that do. python-flint is imported
+lazily (the package renders from stored tables; only the derivations need it).
 
 The package's derivations build their systems in float64. :func:`rationals` recovers the exact entries: each
 float is replaced by the fraction of denominator <= ``max_den`` nearest to it, which must lie within ``tol``
@@ -21,7 +27,17 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["rationals", "qmat", "fractions_of", "lstsq_full_rank", "least_norm", "literal"]
+__all__: list = []  # private: used by the derivations (tools/gen_*.py, splinevis.volume.schemes)
+
+
+def flint_module():
+    """python-flint, or an ImportError saying how to get it."""
+    try:
+        import flint
+    except ImportError as err:  # pragma: no cover - the test extra installs it
+        raise ImportError("this derivation solves in exact rational arithmetic with python-flint: "
+                          "pip install python-flint (part of splinevis' test extra).") from err
+    return flint
 
 
 def rationals(a, *, max_den: int = 1000, tol: float = 1e-12, what: str = "entry") -> list:
@@ -46,7 +62,7 @@ def rationals(a, *, max_den: int = 1000, tol: float = 1e-12, what: str = "entry"
 
 def qmat(a, **kw):
     """``flint.fmpq_mat`` of the exact fractions behind the float64 matrix ``a`` (2-D; see :func:`rationals`)."""
-    import flint
+    flint = flint_module()
 
     a = np.atleast_2d(np.asarray(a, dtype=np.float64))
     qs = rationals(a, **kw)
@@ -82,7 +98,7 @@ def least_norm(A, b):
     """Exact least-norm solution of the consistent system ``A x = b`` (fmpq_mat in and out): with ``A_r`` a
     maximal set of independent rows, ``x = A_r^T (A_r A_r^T)^-1 b_r`` (the pseudo-inverse solution ``A^+ b``,
     which float64 ``lstsq`` approximates). Raises if ``A x = b`` has no solution."""
-    import flint
+    flint = flint_module()
 
     rows = _pivot_rows(A)
     tab, btab = A.table(), b.table()
@@ -103,3 +119,55 @@ def literal(q: Fraction) -> str:
     """
     r = repr(float(q))
     return r if ("." in r or "e" in r or "n" in r) else r + ".0"
+
+
+def _pivots(R, rank) -> list:
+    tab = R.table()
+    return [next(j for j, v in enumerate(tab[i]) if v != 0) for i in range(rank)]
+
+
+def solve_any(A, b):
+    """A solution ``x`` of ``A x = b`` (fmpq_mat; ``b`` one column), the free unknowns zero, or None if the
+    system is inconsistent (a pivot of ``rref([A | b])`` in the last column).
+
+    >>> import flint
+    >>> A = flint.fmpq_mat(2, 2, [1, 1, 2, 2])
+    >>> solve_any(A, flint.fmpq_mat(2, 1, [3, 6])).entries(), solve_any(A, flint.fmpq_mat(2, 1, [3, 7]))
+    ([3, 0], None)
+    """
+    flint = flint_module()
+    n = A.ncols()
+    M = flint.fmpq_mat(A.nrows(), n + 1, [v for ra, rb in zip(A.table(), b.table()) for v in ra + rb])
+    R, rank = M.rref()
+    piv = _pivots(R, rank)
+    if piv and piv[-1] == n:
+        return None
+    tab = R.table()
+    x = [flint.fmpq(0)] * n
+    for i, j in enumerate(piv):
+        x[j] = tab[i][n]
+    return flint.fmpq_mat(n, 1, x)
+
+
+def nullspace(A):
+    """A basis of ``{x : A x = 0}`` as the columns of an fmpq_mat (``ncols x k``; ``k = 0`` gives an empty one):
+    one column per free unknown of ``rref(A)``.
+
+    >>> import flint
+    >>> nullspace(flint.fmpq_mat(1, 3, [1, 1, 0])).table()
+    [[-1, 0], [1, 0], [0, 1]]
+    """
+    flint = flint_module()
+    n = A.ncols()
+    R, rank = A.rref()
+    piv = _pivots(R, rank)
+    free = [j for j in range(n) if j not in set(piv)]
+    tab = R.table()
+    cols = []
+    for f in free:
+        v = [flint.fmpq(0)] * n
+        v[f] = flint.fmpq(1)
+        for i, j in enumerate(piv):
+            v[j] = -tab[i][f]
+        cols.append(v)
+    return flint.fmpq_mat(n, len(cols), [cols[c][r] for r in range(n) for c in range(len(cols))])
