@@ -79,6 +79,36 @@ def _cmd_study(args) -> int:
     return 0 if result else 1
 
 
+def _cmd_check(args) -> int:
+    import json
+
+    from .check import check
+
+    known = {}
+    if args.known:
+        known = json.loads(Path(args.known).read_text())
+        if not isinstance(known, dict):
+            raise ValueError(f"{args.known}: expected a JSON object {{file name: measured reason}}.")
+    report = check(args.paths, args.out, family=args.family, isovalue=args.isovalue, jobs=args.jobs,
+                   progress=not args.quiet)
+    counts = report["counts"]
+    print(" ".join(f"{k} {v}" for k, v in counts.items()) + f"; report: {Path(args.out) / 'report.md'}")
+    unexpected = []
+    for r in report["files"]:
+        if r["verdict"] == "FAIL":
+            reason = next((f["reason"] for f in r["findings"] if f["level"] == "FAIL"), "")
+            listed = r["name"] in known
+            print(f"FAIL{' (known)' if listed else ''} {r['name']}: {reason[:300]}")
+            if not listed:
+                unexpected.append(r["name"])
+        elif r["name"] in known:
+            print(f"now {r['verdict']}: {r['name']} is listed in {args.known} as failing; remove its entry")
+    missing = sorted(set(known) - {r["name"] for r in report["files"]})
+    if missing:
+        print(f"listed in {args.known} but not checked: {', '.join(missing)}")
+    return 1 if unexpected else 0
+
+
 def main(argv=None) -> int:
     """Run the ``splinevis`` command with ``argv`` (default: ``sys.argv[1:]``); returns the exit code.
 
@@ -128,6 +158,16 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="smaller sizes: a few minutes")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_study)
+    p = sub.add_parser("check", help="judge files: read, draw beside the mesh users have, measure; PASS/WARN/FAIL")
+    p.add_argument("paths", nargs="+", help="files and folders (walked)")
+    p.add_argument("--out", default="out/check", help="report folder (default out/check)")
+    p.add_argument("--family", choices=["auto", "terrain", "volume", "nurbs", "mesh"], default="auto")
+    p.add_argument("--isovalue", type=float, default=None, help="isovalue of volumes (default: from the histogram)")
+    p.add_argument("--jobs", type=int, default=2, help="files judged at once (default 2)")
+    p.add_argument("--known", default=None,
+                   help="JSON {file name: reason} of files allowed to FAIL (exit status 1 on any other FAIL)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_check)
     args = parser.parse_args(argv)
     from .errors import OpenGLUnavailableError
 

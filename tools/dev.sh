@@ -69,5 +69,16 @@ case "$job" in
         fi
         exit "$rc"
         ;;
-    *) echo "usage: bash tools/dev.sh {setup|demo|test|selftest|bench} [args]" >&2; exit 2 ;;
+    check)
+        # splinevis check on the real files (../shared/data, or SPLINEVIS_REALDATA): files listed in
+        # tests/realdata_known.json may FAIL (each with its measured reason); any other FAIL fails the job, a
+        # listed file that passes is printed so that its entry can go
+        data="${SPLINEVIS_REALDATA:-../shared/data}"
+        if [ ! -d "$data" ]; then
+            echo "[splinevis] no real-file folder at $data: splinevis check not run"
+            exit 0
+        fi
+        .venv/bin/splinevis check "$data" --out "${1:-out/check}" --known tests/realdata_known.json --quiet
+        ;;
+    *) echo "usage: bash tools/dev.sh {setup|demo|test|check|selftest|bench} [args]" >&2; exit 2 ;;
 esac
