@@ -187,7 +187,8 @@ def picture_findings(view: str, m: dict) -> list:
                                    f"(< {THRESHOLDS['iou_warn']})"))
     if m["leak_fraction"] > THRESHOLDS["leak_fail"]:
         out.append(Finding("FAIL", f"{view} view: {m['leaks']} background pixels inside the silhouette "
-                                   f"({100 * m['leak_fraction']:.2f} % of its interior: holes)"))
+                                   f"({100 * m['leak_fraction']:.2f} % of its interior: holes, or a different shape "
+                                   f"where IoU is low)"))
     elif m["leak_fraction"] > THRESHOLDS["leak_warn"]:
         out.append(Finding("WARN", f"{view} view: {m['leaks']} background pixels inside the silhouette "
                                    f"({100 * m['leak_fraction']:.2f} % of its interior)"))

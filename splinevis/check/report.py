@@ -8,6 +8,7 @@ Numbers are written as measured; times and memory depend on the machine, verdict
 from __future__ import annotations
 
 import json
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -87,8 +88,8 @@ def _contact_sheet(report, out: Path):
             ax.imshow(np.asarray(Image.open(out / thumb)))
         else:
             reason = next((f["reason"] for f in r["findings"] if f["level"] == "FAIL"), "")
-            ax.text(0.5, 0.5, "no picture: " + reason[:160], ha="center", va="center", fontsize=9, wrap=True,
-                    transform=ax.transAxes)
+            text = "\n".join(textwrap.wrap("no picture: " + reason, 110)[:5])
+            ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=10, transform=ax.transAxes)
         ax.set_title(f"{r['name']} ({r['family']}): {r['verdict']}", loc="left", fontsize=11,
                      color=_COLOURS[r["verdict"]])
         ax.axis("off")

@@ -8,7 +8,8 @@ camera and close-up) written as ``<out>/thumbs/<name>.png``.
 
 Times (seconds, ``time.perf_counter``): ``read`` (the family reader), ``build`` (the spline model),
 ``baseline`` (the mesh users have), ``first_frame`` (first render: shader compile and upload),
-``second_frame`` (a render of the same scene again).
+``second_frame`` (a render of the same scene again), ``accuracy`` (the family's accuracy figure; part of the
+check, not of drawing the file).
 """
 
 from __future__ import annotations
@@ -152,7 +153,9 @@ def judge_file(path, family, out, *, options: dict | None = None) -> dict:
                 m = silhouette_measures(spline_views[view][1], base_views[view][1])
                 result["views"][view] = dict(m, camera=cams[view])
                 findings += picture_findings(view, m)
+            t = time.perf_counter()
             result["accuracy"] = judge.accuracy(path, data, model, base, options, findings)
+            result["times"]["accuracy"] = time.perf_counter() - t
             thumbs = out / "thumbs"
             thumbs.mkdir(parents=True, exist_ok=True)
             images = [spline_views["default"][0], base_views["default"][0], spline_views["close-up"][0],
@@ -163,7 +166,7 @@ def judge_file(path, family, out, *, options: dict | None = None) -> dict:
         except Exception as exc:  # any failure of the user's file is the verdict, with where it happened
             findings.append(Finding("FAIL", f"{stage} failed: {type(exc).__name__}: {exc}"))
             result["traceback"] = traceback.format_exc(limit=6)
-    result["warnings"] = sorted({str(w.message) for w in caught})
+    result["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))  # in the order raised, once each
     if result["warnings"]:
         findings.append(Finding("WARN", f"{len(result['warnings'])} warning(s) while reading and drawing "
                                         f"(first: {result['warnings'][0][:200]})"))

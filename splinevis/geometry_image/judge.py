@@ -1,0 +1,375 @@
+"""What ``splinevis check`` does with a closed triangle mesh (family ``"mesh"``): the smooth geometry image
+[Losasso2003] drawn beside the mesh itself.
+
+* **read**: OBJ, PLY, STL and VTP with pyvista; OFF with libigl (VTK has no OFF reader). The faces are then put
+  in the form a spherical parametrization [PraunHoppe2003] needs, and every change is a WARN finding saying what
+  was done: points at exactly the same position are welded into one vertex (VTK's OBJ reader gives every face
+  corner its own point when the file has texture coordinates or normals, so the mesh arrives as a soup of
+  separate faces), points no face uses are dropped, and polygons are triangulated. Each polygon is split into
+  a fan whose diagonals are not edges of the mesh already: a fixed fan can make a closed quad mesh
+  non-manifold (two quads sharing two sides, as in ``beast.obj``, each cut along the same diagonal, make one
+  triangle twice); among the fans that qualify, the one with the shortest diagonals.
+* **build**: the program's ``model_from`` (:func:`.program.model_from`, what
+  :meth:`splinevis.plotting.Plotter.add_geometry_image` does), options ``n`` (samples per side, default 65) and
+  ``fairness`` (default 0.1). A mesh that is not a closed, connected, oriented genus-0 2-manifold raises
+  :class:`splinevis.errors.MeshTopologyError` naming the check that failed; it is not caught (``run.py``
+  makes it the FAIL).
+* **add**: ``Plotter.add_geometry_image`` with its defaults (option ``level``, default 3).
+* **baseline**: the input mesh (after the repairs above), in the same coordinates as the geometry image.
+* **accuracy**: the limit surface is subdivided ``measure_level`` times (default: one level finer than drawn,
+  so the triangles' chord error is a quarter of the drawn mesh's) and compared with the input mesh by
+  :func:`.measure.surface_distance`: the symmetric Hausdorff distance and the RMS, in units of the input's
+  bounding-box diagonal. Folds: ``folded_triangles`` counts the limit triangles whose orientation points
+  against the exact normals at their corners (:func:`.build.folded_fraction`), the creases where the surface
+  folds over. The triangles at the four cut vertices are counted apart (``cut_vertex_folded``): the tangents
+  vanish there, and the triangles touching a cut vertex often flip at every level on an image that does not
+  fold (one to three on the real meshes tried). Where the surface bends sharply within one triangle (strongly stretched parts of the image), the triangles
+  of a coarse level flip although the surface does not fold; a finer level removes them (on ``elephant.obj``
+  700 at level 3, 30 at level 4, none at level 5). The count on the measured level judges the surface, and the
+  count on the drawn level (``drawn_folded``, the same limit points subsampled) judges what is drawn.
+  These creases do not measure how much of the surface is folded, and they miss folds: a 5 x 5 block of the
+  17 x 17 image of a star blob turned over (its columns reversed) moves the surface by 8 % of the diagonal and
+  flips no triangle at level 4, since inside the block the normals turn with the triangles. ``reversed_fraction``
+  measures the folded area instead: the fraction of the limit points (on the level-2 grid, each standing for
+  an equal share of the image) whose exact normal is more than 120 degrees from the outward normal of the
+  input triangle closest to them. A fold's middle sheet faces backwards (turned-over block: 6 % of the points),
+  while the blob's own geometry image has none. Where the input itself folds back (a triangle more than
+  120 degrees from a neighbour, as 103 of ``decimated-max.obj``'s are), its closest-triangle normal
+  means nothing, and those points are not judged (``input_folded_faces`` counts such triangles).
+
+Thresholds (:data:`THRESHOLDS`) are in pixels of the check's own views. ``run.py`` draws at
+``WINDOW = (400, 300)`` with VTK's default camera, which fits the bounding sphere (diameter = the diagonal)
+into the 30 degree view: the 300 pixel height spans ``diagonal / cos 15 deg``, so 1 % of the diagonal is
+2.9 pixels in the default view and 8.7 in the 3x close-up.
+
+* Hausdorff above 0.5 % of the diagonal: WARN. Somewhere the surface departs from the mesh by 1.5 pixels in
+  the default view and 4 in the close-up, so a user comparing the two pictures can see it.
+* Hausdorff above 3 %: FAIL. That is 9 pixels in the default view: the outline is a different shape.
+* Any folded limit triangle: WARN. A fold is a visible shading defect (a crease that catches the light
+  wrongly) wherever the camera comes close. Folded triangles on the drawn level only: WARN too, because
+  they are drawn facing against the normals they are lit with.
+* Folded limit triangles above 1e-3 of all: FAIL. The threshold is :data:`.build.FOLDED_WARNING`, the one the
+  build warns at. A fold's crease flips a handful of triangles at any level (0 to 20 for a 5 x 5 block of a
+  17 x 17 image turned over, at levels 1 to 4), so 1e-3 of the 2 million triangles of a
+  65 x 65 image at level 4 means a hundred folds or more: the whole surface ripples.
+* Normals reversed at more than 1e-3 of the surface: FAIL. That is four control cells of a 65 x 65 image
+  (4 / 64^2) turned inside out, a patch several pixels across shaded from behind. Any reversed point: WARN.
+
+Why our own code: the distances are libigl's (through :mod:`.measure`), the checks and fits the geometry image's
+own; this module only reads, repairs with a report, and judges.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..check.judge import FamilyJudge, Finding
+from .build import FOLDED_WARNING
+
+__all__ = ["JUDGE"]
+
+#: Option defaults: ``n`` and ``fairness`` of the build, ``level`` drawn, ``measure_level`` (None: ``level`` + 1).
+DEFAULTS = {"n": 65, "fairness": 0.1, "level": 3.0, "measure_level": None}
+
+#: Verdict thresholds (module docstring): distances in units of the input's bounding-box diagonal.
+THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FOLDED_WARNING, "reversed_fail": 1e-3}
+
+#: The level whose limit points the reversed normals are counted on (module docstring).
+REVERSED_LEVEL = 2
+
+_POLYGON_NAMES = {3: "triangles", 4: "quads", 5: "pentagons", 6: "hexagons"}
+
+
+@dataclass(frozen=True, eq=False)
+class MeshData:
+    """What the reader gives the other stages: the repaired triangle mesh and its name for messages."""
+
+    mesh: object  # pyvista.PolyData of triangles
+    name: str
+
+
+def _option(options, key):
+    value = (options or {}).get(key)
+    return DEFAULTS[key] if value is None else value
+
+
+# ---------------------------------------------------------------------------------------------------- read
+
+
+def _polygons_from_vtk(mesh):
+    """``(points, offsets, connectivity, ignored)`` of a pyvista PolyData's polygons (triangle strips split into
+    triangles); ``ignored`` counts its vertex and line cells."""
+    import pyvista as pv
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    points = np.asarray(mesh.points, dtype=np.float64)
+    polys = mesh.GetPolys()
+    offsets = vtk_to_numpy(polys.GetOffsetsArray()).astype(np.int64)
+    conn = vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64)
+    if mesh.n_strips:
+        tri = pv.PolyData(mesh.points, strips=mesh.strips).triangulate()
+        t = np.asarray(tri.faces).reshape(-1, 4)[:, 1:].astype(np.int64)
+        offsets = np.concatenate([offsets, offsets[-1] + 3 * np.arange(1, len(t) + 1)])
+        conn = np.concatenate([conn, t.ravel()])
+    return points, offsets, conn, int(mesh.n_verts + mesh.n_lines)
+
+
+def _triangulate(points, offsets, conn):
+    """Triangles ``(T, 3)`` of polygons given as VTK offsets and connectivity (module docstring: fans whose
+    diagonals are not edges already, shortest first); also the polygon sizes."""
+    sizes = np.diff(offsets)
+    if sizes.size == 0:
+        return np.zeros((0, 3), np.int64), sizes
+    if (sizes == 3).all():
+        return conn.reshape(-1, 3), sizes
+    if (sizes < 3).any():
+        c = int(np.flatnonzero(sizes < 3)[0])
+        raise ValueError(f"polygon {c} has {int(sizes[c])} vertices; a face needs at least 3.")
+    edges = set()
+    for k in np.unique(sizes):
+        ring = conn[offsets[:-1][sizes == k][:, None] + np.arange(k)]
+        e = np.sort(np.stack([ring, np.roll(ring, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
+        edges.update(map(tuple, e.tolist()))
+    triangles = [conn[offsets[:-1][sizes == 3][:, None] + np.arange(3)]]
+    for k in np.unique(sizes[sizes > 3]).tolist():
+        ring = conn[offsets[:-1][sizes == k][:, None] + np.arange(k)]  # (polygons, k)
+        j = np.arange(2, k - 1)
+        # fan from corner s: diagonals (ring[s], ring[s + j]); its total diagonal length, (polygons, k)
+        length = np.stack([np.linalg.norm(points[ring[:, (s + j) % k]] - points[ring[:, [s]]], axis=-1).sum(axis=1)
+                           for s in range(k)], axis=1)
+        order = np.argsort(length, axis=1, kind="stable")
+        chosen = np.empty(len(ring), dtype=np.int64)
+        for i, (r, starts) in enumerate(zip(ring.tolist(), order.tolist())):
+            for s in starts:
+                diagonals = [(min(r[s], r[(s + jj) % k]), max(r[s], r[(s + jj) % k])) for jj in range(2, k - 1)]
+                if not any(d in edges for d in diagonals):
+                    break
+            else:
+                s = starts[0]  # every fan repeats an edge: the shortest (the topology check will say where)
+                diagonals = [(min(r[s], r[(s + jj) % k]), max(r[s], r[(s + jj) % k])) for jj in range(2, k - 1)]
+            edges.update(diagonals)
+            chosen[i] = s
+        fan = ring[np.arange(len(ring))[:, None], (chosen[:, None] + np.arange(k)) % k]  # rotated to start at s
+        triangles.append(np.stack([np.repeat(fan[:, :1], k - 2, axis=1), fan[:, 1:-1], fan[:, 2:]],
+                                  axis=-1).reshape(-1, 3))
+    return np.concatenate(triangles).astype(np.int64), sizes
+
+
+def _read(path, options, findings) -> MeshData:
+    """Read ``path`` and repair it into one triangle mesh, reporting each repair (module docstring)."""
+    import pyvista as pv
+
+    path = Path(path)
+    if path.suffix.lower() == ".off":
+        import igl
+
+        V, F = igl.read_triangle_mesh(str(path))  # triangulates polygons itself (fans)
+        points = np.asarray(V, dtype=np.float64)
+        F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
+        offsets, conn, ignored = np.arange(0, 3 * len(F) + 1, 3, dtype=np.int64), F.ravel(), 0
+    else:
+        mesh = pv.read(path)
+        if not isinstance(mesh, pv.PolyData):
+            mesh = mesh.extract_surface(algorithm=None)
+        points, offsets, conn, ignored = _polygons_from_vtk(mesh)
+    if conn.size == 0:
+        raise ValueError(f"{path.name} has no faces ({len(points)} points): a point cloud or lines are not a surface.")
+    if ignored:
+        findings.append(Finding("WARN", f"ignored {ignored:,} point and line cells: only faces are drawn"))
+    if not np.isfinite(points).all():
+        raise ValueError(f"{path.name}: {int((~np.isfinite(points)).any(axis=1).sum())} points have a NaN or "
+                         "infinite coordinate.")
+
+    used = np.unique(conn)
+    if used.size < len(points):
+        findings.append(Finding("WARN", f"dropped {len(points) - used.size:,} of {len(points):,} points that no face "
+                                        "uses"))
+    # weld points at exactly the same position (+ 0.0 makes -0.0 and 0.0 one key), kept in the file's order: a file
+    # needing no repair keeps its vertex numbers, so the build is the one add_geometry_image makes of it (the
+    # spherical parametrization depends on the order)
+    _, first, inverse = np.unique(points[used] + 0.0, axis=0, return_index=True, return_inverse=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+    unique = points[used][np.sort(first)]
+    remap = np.empty(len(points), dtype=np.int64)
+    remap[used] = rank[inverse.ravel()]
+    conn = remap[conn]
+    if len(unique) < used.size:
+        findings.append(Finding("WARN", f"welded {used.size:,} points into {len(unique):,} vertices (points at exactly "
+                                        "the same position; VTK's reader gives each face corner its own point when "
+                                        "an OBJ file has texture coordinates or normals)"))
+    tri, sizes = _triangulate(unique, offsets, conn)
+    if (sizes != 3).any():
+        count = Counter(sizes.tolist())
+        what = ", ".join(f"{count[k]:,} {_POLYGON_NAMES.get(k, f'{k}-gons')}" for k in sorted(count) if k != 3)
+        findings.append(Finding("WARN", f"triangulated {int((sizes != 3).sum()):,} polygons ({what}) into "
+                                        f"{len(tri):,} triangles in all (fans whose diagonals are not edges already)"))
+    faces = np.column_stack([np.full(len(tri), 3, dtype=np.int64), tri]).ravel()
+    return MeshData(pv.PolyData(unique, faces), path.name)
+
+
+# ---------------------------------------------------------------------------------------------------- build, draw
+
+
+def _build(data: MeshData, options, findings):
+    from ..programs import get
+
+    n = int(_option(options, "n"))
+    return get("geometry_image").model_from(data.mesh, n, fairness=float(_option(options, "fairness")),
+                                            name=data.name)
+
+
+def _baseline(data: MeshData, model, options, findings):
+    return data.mesh
+
+
+def _add(plotter, model, options):
+    return plotter.add_geometry_image(model, level=float(_option(options, "level")))
+
+
+# ---------------------------------------------------------------------------------------------------- accuracy
+
+
+def _measure_level(options) -> int:
+    level = _option(options, "measure_level")
+    if level is None:
+        level = max(math.floor(float(_option(options, "level"))) + 1, 0)
+    level = int(level)
+    if not 0 <= level <= 6:
+        raise ValueError(f"measure_level must be in 0..6, got {level}.")
+    return level
+
+
+def _input_arrays(mesh):
+    V = np.ascontiguousarray(mesh.points, dtype=np.float64)
+    F = np.ascontiguousarray(np.asarray(mesh.faces).reshape(-1, 4)[:, 1:], dtype=np.int64)
+    return V, F
+
+
+def _folds(P, N, T, M):
+    """``(folded, at_cut)``: triangles turned against the normals at their corners, away from the four cut
+    vertices and at them, of the ``M x M`` grid ``P, N, T``."""
+    from .image import cut_vertices
+
+    orient = np.cross(P[T[:, 1]] - P[T[:, 0]], P[T[:, 2]] - P[T[:, 0]])
+    folded = np.einsum("ij,ij->i", orient, N[T].sum(axis=1)) < 0.0
+    at_cut = np.isin(T, cut_vertices(M) @ np.array([M, 1])).any(axis=1)
+    return int((folded & ~at_cut).sum()), int((folded & at_cut).sum())
+
+
+def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = None) -> dict:
+    """The accuracy figures of the geometry image ``model`` against the triangle mesh ``mesh`` (module docstring),
+    the limit surface subdivided ``measure_level`` times; folds also on the drawn level ``drawn_level`` (at most
+    ``measure_level``; None: ``measure_level - 1``), the same limit points subsampled.
+
+    Examples
+    --------
+    >>> from datasets_synthetic.closed_meshes import star_blob
+    >>> from splinevis.geometry_image.program import model_from
+    >>> blob = star_blob(level=2)
+    >>> m = surface_measures(model_from(blob, 17), blob, 2)
+    >>> m["limit_triangles"], m["folded_triangles"], m["drawn_folded"], bool(m["hausdorff"] < 0.03)
+    (8192, 0, 0, True)
+    """
+    from .build import limit_mesh_arrays
+    from .measure import surface_distance
+    from .subdivision import grid_faces
+
+    V, F = _input_arrays(mesh)
+    P, N, T = limit_mesh_arrays(model, measure_level)
+    M = int(round(math.sqrt(len(P))))
+    out = dict(surface_distance(P, T, V, F))
+    folded, at_cut = _folds(P, N, T, M)
+    out.update(measure_level=int(measure_level), limit_triangles=int(len(T)), folded_triangles=folded,
+               folded_fraction=folded / len(T), cut_vertex_folded=at_cut)
+    drawn = max(int(measure_level) - 1, 0) if drawn_level is None else min(int(drawn_level), int(measure_level))
+    step = 1 << (int(measure_level) - drawn)
+    Md = (M - 1) // step + 1
+    Pd = P.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
+    Nd = N.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
+    out.update(drawn_level=drawn, drawn_folded=_folds(Pd, Nd, grid_faces(Md), Md)[0])
+    out.update(_reversed(P, N, M, int(measure_level), V, F))
+    out.update(input_vertices=int(len(V)), input_triangles=int(len(F)), n=int(model.n))
+    return out
+
+
+def _reversed(P, N, M, level, V, F) -> dict:
+    """Limit points on the level-:data:`REVERSED_LEVEL` grid whose exact normal is more than 120 degrees from the
+    outward normal of the input triangle closest to them, where the input itself does not fold (no neighbour of
+    the closest triangle faces more than 120 degrees away from it); module docstring."""
+    import igl
+
+    from .image import cut_vertices
+
+    face_normal = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    adjacent, _ = igl.triangle_triangle_adjacency(F)
+    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    step = 1 << max(level - REVERSED_LEVEL, 0)
+    grid = np.zeros((M, M), bool)
+    grid[::step, ::step] = True
+    grid.ravel()[cut_vertices(M) @ np.array([M, 1])] = False
+    idx = np.flatnonzero(grid.ravel())
+    _, closest, _ = igl.point_mesh_squared_distance(np.ascontiguousarray(P[idx]), V, F)
+    judged = ~folds_itself[closest]
+    against = judged & (np.einsum("ij,ij->i", N[idx], face_normal[closest]) < -0.5)
+    return {"reversed_points": int(against.sum()), "reversed_fraction": float(against.sum() / max(judged.sum(), 1)),
+            "reversed_grid_points": int(judged.sum()), "input_folded_faces": int(folds_itself.sum())}
+
+
+def _pixels(fraction: float) -> str:
+    from ..check.run import CLOSE_UP_ZOOM, WINDOW
+
+    default = fraction * WINDOW[1] * math.cos(math.radians(15.0))
+    return f"{default:.1f} px in the default view, {default * CLOSE_UP_ZOOM:.1f} px in the close-up"
+
+
+def _accuracy(path, data: MeshData, model, baseline, options, findings) -> dict:
+    m = surface_measures(model, data.mesh, _measure_level(options),
+                         min(math.floor(float(_option(options, "level"))), _measure_level(options)))
+    t = THRESHOLDS
+    h, rms = m["hausdorff"], m["rms"]
+    what = (f"the smooth surface (limit at level {m['measure_level']}, {m['n']} x {m['n']} image) is within "
+            f"{100 * h:.2f} % of the bounding-box diagonal of the input mesh ({_pixels(h)}; Hausdorff, RMS "
+            f"{100 * rms:.3f} %)")
+    if h > t["hausdorff_fail"]:
+        findings.append(Finding("FAIL", f"{what}: more than {100 * t['hausdorff_fail']:g} %, a different shape"))
+    elif h > t["hausdorff_warn"]:
+        findings.append(Finding("WARN", f"{what}: more than {100 * t['hausdorff_warn']:g} %, visible in a close-up"))
+    else:
+        findings.append(Finding("PASS", what))
+
+    folds, frac, rev = m["folded_triangles"], m["folded_fraction"], m["reversed_fraction"]
+    fold = (f"{folds:,} of the {m['limit_triangles']:,} limit triangles at level {m['measure_level']} turn against "
+            f"the surface normals at their corners (not counting {m['cut_vertex_folded']} at the cut vertices), and "
+            f"the normals point into the mesh at {m['reversed_points']:,} of {m['reversed_grid_points']:,} limit "
+            f"points ({100 * rev:.3g} % of the surface)")
+    note = ""
+    if m["input_folded_faces"]:
+        note = (f" ({m['input_folded_faces']:,} triangles of the input fold back more than 120 degrees against a "
+                "neighbour; limit points closest to them are not judged)")
+    if frac > t["folded_fail"] or rev > t["reversed_fail"]:
+        why = [f"folds along more than {100 * t['folded_fail']:g} % of the limit triangles"] * (frac > t["folded_fail"])
+        why += [f"inside out over more than {100 * t['reversed_fail']:g} % of the surface"] * (rev > t["reversed_fail"])
+        findings.append(Finding("FAIL", f"{fold}: {' and '.join(why)}, a visible defect{note}"))
+    elif folds or m["reversed_points"]:
+        findings.append(Finding("WARN", f"{fold}: the surface folds over there, a shading defect seen close up{note}"))
+    elif m["drawn_folded"]:
+        findings.append(Finding("WARN", f"the drawn mesh (level {m['drawn_level']}) has {m['drawn_folded']:,} "
+                                        "triangles turned against the normals they are lit with, where the surface "
+                                        "bends more within a triangle than the triangle can follow; "
+                                        f"the limit surface has no fold ({fold}){note}"))
+    else:
+        findings.append(Finding("PASS", f"no folds: {fold}{note}"))
+    return m
+
+
+JUDGE = FamilyJudge(
+    family="mesh", baseline_name="input mesh", read=_read, build=_build, baseline=_baseline, accuracy=_accuracy,
+    add=_add, description="a closed genus-0 triangle mesh as a smooth geometry image [Losasso2003]",
+    extra={"defaults": DEFAULTS, "thresholds": THRESHOLDS})
