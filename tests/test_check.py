@@ -221,3 +221,17 @@ def test_check_command_writes_the_report_and_exits_1_on_an_unlisted_fail(hill, t
     known = tmp_path / "known.json"
     known.write_text(json.dumps({"broken.asc": "cut short"}))
     assert main(["check", str(p), str(bad), "--out", str(out), "--quiet", "--known", str(known)]) == 0
+
+
+def test_the_real_file_known_list_is_file_names_with_measured_reasons():
+    """tests/realdata_known.json (read by ``make check`` and CI): a flat object, bare file names (what the
+    report's "name" holds), each with a reason in words; no machine's absolute path."""
+    import re
+    from pathlib import Path
+
+    known = json.loads((Path(__file__).parent / "realdata_known.json").read_text())
+    assert isinstance(known, dict)
+    for name, reason in known.items():
+        assert "/" not in name and name == name.strip(), name
+        assert isinstance(reason, str) and len(reason) > 20, name
+        assert not re.search(r"(?<![\w.])/[A-Za-z_]+/", reason), f"{name}: an absolute path in {reason!r}"

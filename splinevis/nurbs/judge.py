@@ -356,7 +356,9 @@ def _baseline(data: NurbsFile, model, options, findings):
     if not 0.0 < relative < 1.0:
         raise ValueError(f"option deflection must be a fraction of the diagonal in (0, 1), got {relative!r}.")
     delta = relative * diagonal
-    BRepMesh_IncrementalMesh(shape, delta, False, ANGULAR_DEFLECTION, True)
+    # one thread: the check already runs files side by side, and OpenCASCADE's thread pool would outlive the mesh
+    # in the process that called it (a pytest worker, a notebook)
+    BRepMesh_IncrementalMesh(shape, delta, False, ANGULAR_DEFLECTION, False)
     pts, uvs, tris, ids, faces = [], [], [], [], []
     offset, unmeshed = 0, 0
     for face in _occ_faces(shape):
