@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["check_knots", "find_span", "basis_funs", "ders_basis_funs", "MAX_DEGREE"]
+__all__ = ["check_knots", "find_span", "basis_funs", "ders_basis_funs", "MAX_DEGREE", "at_fraction", "into_domain"]
 
 #: Highest degree handled (per direction).
 MAX_DEGREE = 7
@@ -70,6 +70,45 @@ def check_knots(knots, degree: int, count: int, name: str = "knots") -> np.ndarr
         raise ValueError(f"{name}: knot {float(values[k])!r} has multiplicity {counts[k]}, more than {limit} for degree "
                          f"{degree} ({'inside the domain: the surface would break apart' if inner[k] else 'at an end'}).")
     return U
+
+
+def at_fraction(lo, hi, t) -> np.ndarray:
+    """Parameters at fractions ``t`` of the domain ``[lo, hi]``, never outside it.
+
+    ``lo + t (hi - lo)`` rounds: with ``lo = -54.0036550378855``, ``hi = -1.2874806216379383e-32`` and ``t = 1`` it
+    gives ``0.0 > hi``, and ``find_span`` refuses it. Here ``t = 0`` gives ``lo`` and ``t = 1`` gives ``hi``
+    exactly, and every value is clamped into ``[lo, hi]`` (a rounding step at most; the fractions themselves
+    must lie in [0, 1]). Broadcasts ``lo``, ``hi`` and ``t``.
+
+    Examples
+    --------
+    >>> at_fraction(-54.0036550378855, -1.2874806216379383e-32, [0.0, 1.0]).tolist()
+    [-54.0036550378855, -1.2874806216379383e-32]
+    >>> float(-54.0036550378855 + 1.0 * (-1.2874806216379383e-32 + 54.0036550378855))  # the plain formula
+    0.0
+    >>> at_fraction(0.0, 1.0, 1.5)
+    Traceback (most recent call last):
+    ValueError: fractions of the knot domain must lie in [0, 1], got 1.5.
+    """
+    lo, hi, t = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(t, dtype=np.float64)
+    if t.size and not (t.min() >= 0.0 and t.max() <= 1.0):  # also refuses NaN
+        bad = t[~((t >= 0.0) & (t <= 1.0))].ravel()[0]
+        raise ValueError(f"fractions of the knot domain must lie in [0, 1], got {float(bad)!r}.")
+    u = np.where(t == 0.0, lo, np.where(t == 1.0, hi, lo + t * (hi - lo)))
+    return np.minimum(np.maximum(u, lo), hi)
+
+
+def into_domain(u, lo, hi) -> np.ndarray:
+    """Clamp parameters computed near the domain (Newton steps, pulled-back trims, a fraction of a span) into
+    ``[lo, hi]``; NaN is refused, not clamped.
+
+    >>> into_domain([1.0000000000000002, -3e-17, 0.5], 0.0, 1.0).tolist()
+    [1.0, 0.0, 0.5]
+    """
+    u = np.asarray(u, dtype=np.float64)
+    if np.isnan(u).any():
+        raise ValueError("a parameter is NaN (a failed projection or a degenerate surface); nothing to clamp.")
+    return np.minimum(np.maximum(u, lo), hi)
 
 
 def find_span(p: int, U: np.ndarray, u) -> np.ndarray:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .basis import at_fraction
 from .surface import NurbsSurface
 
 __all__ = ["Seam", "find_seams", "seam_lines", "CLASS_COLORS"]
@@ -64,9 +65,9 @@ def _boundary_params(s: NurbsSurface, side: str, t: np.ndarray):
     (u0, u1), (v0, v1) = s.domain
     if side.startswith("u"):
         u = np.full_like(t, u0 if side.endswith("0") else u1)
-        return u, v0 + t * (v1 - v0)
+        return u, at_fraction(v0, v1, t)
     v = np.full_like(t, v0 if side.endswith("0") else v1)
-    return u0 + t * (u1 - u0), v
+    return at_fraction(u0, u1, t), v
 
 
 def _cross_curvature(s: NurbsSurface, u, v, along_u: bool, n_ref):

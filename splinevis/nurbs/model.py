@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .basis import check_knots, ders_basis_funs, find_span
+from .basis import at_fraction, check_knots, ders_basis_funs, find_span
 from .surface import NurbsSurface
 
 __all__ = ["TrimCurve", "NurbsModel"]
@@ -144,7 +144,7 @@ class NurbsModel:
         parts = []
         for s in self.surfaces:
             (u0, u1), (v0, v1) = s.domain
-            U, V = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
+            U, V = np.meshgrid(at_fraction(u0, u1, t), at_fraction(v0, v1, t))
             parts.append(s.curvature(U.ravel(), V.ravel()))
         return {key: np.concatenate([c[key] for c in parts]) for key in parts[0]}
 

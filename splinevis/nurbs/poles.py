@@ -42,7 +42,7 @@ import weakref
 
 import numpy as np
 
-from .basis import ders_basis_funs, find_span
+from .basis import at_fraction, ders_basis_funs, find_span
 
 __all__ = ["POLE_TABLE", "pole_curve", "pole_normal", "antipode", "pole_table", "pole_tables", "cross_pole"]
 
@@ -85,7 +85,7 @@ def pole_curve(s, edge: int, t):
 
 def _grid(s, edge, m):
     lo, hi = _edge_data(s, edge)[2]
-    return lo + (hi - lo) * np.arange(m + 1) / m
+    return at_fraction(lo, hi, np.arange(m + 1) / m)
 
 
 def pole_normal(s, edge: int, samples: int = 1024):

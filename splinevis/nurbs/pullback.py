@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .basis import check_knots, ders_basis_funs, find_span
+from .basis import at_fraction, check_knots, into_domain, ders_basis_funs, find_span
 from .model import TrimCurve
 from .surface import NurbsSurface
 
@@ -122,7 +122,7 @@ class _Inverter:
         self.closed = np.zeros(2, dtype=bool)
         a = np.linspace(0, 1, 9)
         (u0, u1), (v0, v1) = self.dom
-        u, v = u0 + a * (u1 - u0), v0 + a * (v1 - v0)
+        u, v = at_fraction(u0, u1, a), at_fraction(v0, v1, a)
         for d, (A, B) in enumerate(((surface.evaluate(np.full(9, u0), v), surface.evaluate(np.full(9, u1), v)),
                                     (surface.evaluate(u, np.full(9, v0)), surface.evaluate(u, np.full(9, v1))))):
             self.closed[d] = np.abs(A - B).max() <= 1e-10 * self.scale
@@ -140,7 +140,7 @@ class _Inverter:
         out = np.empty_like(uv)
         for d in range(2):
             a, b = self.dom[d]
-            out[:, d] = a + np.mod(uv[:, d] - a, b - a) if self.closed[d] else np.clip(uv[:, d], a, b)
+            out[:, d] = into_domain(a + np.mod(uv[:, d] - a, b - a) if self.closed[d] else uv[:, d], a, b)
         return out
 
     def newton(self, X, uv, iterations: int = 50):

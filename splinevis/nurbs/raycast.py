@@ -17,6 +17,7 @@ import numpy as np
 
 from ..gl.contract import RayHits
 from ..gl.error_bounds import U32, depth_error, model_frame_matrix
+from .basis import at_fraction, into_domain
 from .model import NurbsModel
 from .poles import cross_pole, pole_tables
 from .surface import NurbsSurface
@@ -45,9 +46,9 @@ def _closed(s: NurbsSurface, axis: int) -> bool:
     (u0, u1), (v0, v1) = s.domain
     t = np.linspace(0.0, 1.0, 7)
     if axis == 0:
-        a, b = s.evaluate(np.full(7, u0), v0 + t * (v1 - v0)), s.evaluate(np.full(7, u1), v0 + t * (v1 - v0))
+        a, b = s.evaluate(np.full(7, u0), at_fraction(v0, v1, t)), s.evaluate(np.full(7, u1), at_fraction(v0, v1, t))
     else:
-        a, b = s.evaluate(u0 + t * (u1 - u0), np.full(7, v0)), s.evaluate(u0 + t * (u1 - u0), np.full(7, v1))
+        a, b = s.evaluate(at_fraction(u0, u1, t), np.full(7, v0)), s.evaluate(at_fraction(u0, u1, t), np.full(7, v1))
     scale = np.abs(s.control_points).max() + np.ptp(s.control_points.reshape(-1, 3), axis=0).max()
     return bool(np.abs(a - b).max() <= 1e-12 * scale)
 
@@ -180,8 +181,8 @@ def certified_deviation(s, us, vs) -> np.ndarray:
     gu, gv = _bernstein_collocation(p + 1), _bernstein_collocation(q + 1)
     fu, fv = np.arange(p + 2) / (p + 1), np.arange(q + 2) / (q + 1)
     nu, nv = len(us) - 1, len(vs) - 1
-    uu = (us[:-1, None] + fu[None, :] * np.diff(us)[:, None])  # (nu, p+2)
-    vv = (vs[:-1, None] + fv[None, :] * np.diff(vs)[:, None])  # (nv, q+2)
+    uu = at_fraction(us[:-1, None], us[1:, None], fu[None, :])  # (nu, p+2), each node inside its cell
+    vv = at_fraction(vs[:-1, None], vs[1:, None], fv[None, :])  # (nv, q+2)
     # keep each node inside its own cell's knot span (the right end of a span belongs to the next one)
     U, V = s.knots
     uu[:, -1] = np.nextafter(uu[:, -1], uu[:, 0])
@@ -271,7 +272,7 @@ def _into_domain(s, closed, uv):
         u = u0 + np.mod(u - u0, u1 - u0)
     if closed[1]:
         v = v0 + np.mod(v - v0, v1 - v0)
-    return np.column_stack([np.clip(u, u0, u1), np.clip(v, v0, v1)])
+    return np.column_stack([into_domain(u, u0, u1), into_domain(v, v0, v1)])
 
 
 def _planes(d):

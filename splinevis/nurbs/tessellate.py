@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .basis import at_fraction
 from .model import NurbsModel
 from .surface import NurbsSurface
 
@@ -31,7 +32,7 @@ def span_grid(surface: NurbsSurface, per_span: int) -> tuple:
     for knots, (lo, hi) in zip(surface.knots, surface.domain):
         k = np.unique(knots[(knots >= lo) & (knots <= hi)])
         t = np.linspace(0.0, 1.0, per_span + 1)[:-1]
-        out.append(np.concatenate([a + t * (b - a) for a, b in zip(k[:-1], k[1:])] + [[hi]]))
+        out.append(np.concatenate([at_fraction(a, b, t) for a, b in zip(k[:-1], k[1:])] + [[hi]]))
     return tuple(out)
 
 
