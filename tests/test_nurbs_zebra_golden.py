@@ -122,3 +122,21 @@ def test_zebra_pictures_match_the_twin_away_from_stripe_edges(measured):
         ok = inner & ~edge & pixels
         assert ok.sum() > 10000
         assert (bright[ok] == ref_bright[ok]).mean() > 0.999
+
+
+def test_stripes_for_view_is_the_largest_count_within_the_pixel_budget():
+    """stripes_for_view: n pairs of stripes at the measured phase rate q (phase per pixel at the quantile) span
+    1 / (n q) pixels; the count is the largest n with 1 / (n q) >= pixels_per_pair, and twice the pixels across
+    the same view halve q (so the count doubles, to within the floor)."""
+    from splinevis.analysis.zebra import stripes_for_view
+    from splinevis.analytic import QuarticTrianglePatch
+
+    patch = QuarticTrianglePatch.demo()
+    a = stripes_for_view(patch, np.eye(4), (80, 60), (1, 0, 0), pixels_per_pair=5.0, quantile=0.8, step=1)
+    n, q = a["stripes"], a["rate_quantile"]
+    assert n * q * 5.0 <= 1.0 < (n + 1) * q * 5.0
+    b = stripes_for_view(patch, np.eye(4), (160, 120), (1, 0, 0), pixels_per_pair=5.0, quantile=0.8, step=1)
+    assert abs(b["rate_quantile"] / q - 0.5) < 0.05  # the same surface sampled at twice the pixels
+    assert 2 * n - 1 <= b["stripes"] <= 2 * n + 2
+    with pytest.raises(ValueError, match="Nyquist"):
+        stripes_for_view(patch, np.eye(4), (80, 60), (1, 0, 0), pixels_per_pair=2.0)
