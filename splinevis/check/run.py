@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import resource
 import sys
 import time
@@ -80,6 +81,22 @@ def _thumb_row(images, labels, path: Path):
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def _relative_paths(text: str) -> str:
+    """A traceback with this installation's folders cut from its file names (``splinevis/check/run.py``, not
+    the machine's absolute path): reports are shared and committed.
+
+    >>> import splinevis, pathlib
+    >>> root = str(pathlib.Path(splinevis.__file__).resolve().parents[1])
+    >>> _relative_paths(f'File "{root}/splinevis/check/run.py", line 1')
+    'File "splinevis/check/run.py", line 1'
+    """
+    import splinevis
+
+    for folder in {Path(splinevis.__file__).resolve().parents[1], Path(sys.prefix).resolve().parent}:
+        text = text.replace(str(folder) + os.sep, "")
+    return text
 
 
 def judge_file(path, family, out, *, options: dict | None = None) -> dict:
@@ -165,7 +182,7 @@ def judge_file(path, family, out, *, options: dict | None = None) -> dict:
             result["thumbnail"] = f"thumbs/{path.name}.png"
         except Exception as exc:  # any failure of the user's file is the verdict, with where it happened
             findings.append(Finding("FAIL", f"{stage} failed: {type(exc).__name__}: {exc}"))
-            result["traceback"] = traceback.format_exc(limit=6)
+            result["traceback"] = _relative_paths(traceback.format_exc(limit=6))
     result["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))  # in the order raised, once each
     if result["warnings"]:
         findings.append(Finding("WARN", f"{len(result['warnings'])} warning(s) while reading and drawing "
