@@ -48,3 +48,28 @@ def test_vase_seams_are_g2_around_and_g1_along_the_profile():
         levels[(s.side_a[0], s.level)] += 1
     assert len(seams) == 60
     assert levels == {("u", "G2"): 32, ("v", "G1"): 28}
+
+
+def test_normal_curvature_on_known_surfaces():
+    # sphere: every direction bends by 1/r; torus: across the tube 1/r, around the axis cos(phi) / (R + r cos(phi))
+    # (signs with respect to the surface's normal); the 2 x 2 solve is vectorized over the points
+    from splinevis.nurbs.continuity import normal_curvature
+    from splinevis.nurbs.exact import sphere, torus
+
+    rng = np.random.default_rng(5)
+    u, v = rng.uniform(0.05, 0.95, 50), rng.uniform(0.1, 0.9, 50)
+    s = sphere(2.0)
+    SKL, n = s.derivatives(u, v, 2), s.normal(u, v)
+    c = np.cross(n, rng.normal(size=(50, 3)))  # random tangent directions
+    k = normal_curvature(SKL, n, c)
+    assert np.abs(np.abs(k) - 0.5).max() <= 1e-12 and np.ptp(np.sign(k)) == 0
+    R, r = 2.0, 0.5
+    t = torus(R, r)
+    SKL, n = t.derivatives(u, v, 2), t.normal(u, v)
+    p = t.evaluate(u, v)
+    rho = np.hypot(p[:, 0], p[:, 1])
+    cos_phi = (rho - R) / r
+    around = np.column_stack([-p[:, 1], p[:, 0], np.zeros(50)])  # the circle about the axis
+    across = np.cross(n, around)
+    assert np.abs(np.abs(normal_curvature(SKL, n, across)) - 1 / r).max() <= 1e-11
+    assert np.abs(np.abs(normal_curvature(SKL, n, around)) - np.abs(cos_phi / rho)).max() <= 1e-11

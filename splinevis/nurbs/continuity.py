@@ -22,7 +22,7 @@ import numpy as np
 from .basis import at_fraction
 from .surface import NurbsSurface
 
-__all__ = ["Seam", "find_seams", "seam_lines", "CLASS_COLORS"]
+__all__ = ["Seam", "find_seams", "seam_lines", "classify", "normal_curvature", "CLASS_COLORS"]
 
 #: Colour of each continuity class in :func:`seam_lines` (RGB in [0, 1]).
 CLASS_COLORS = {"G2": (0.1, 0.7, 0.2), "G1": (0.95, 0.8, 0.1), "G0": (0.95, 0.45, 0.05), "open": (0.85, 0.0, 0.0)}
@@ -70,6 +70,45 @@ def _boundary_params(s: NurbsSurface, side: str, t: np.ndarray):
     return at_fraction(u0, u1, t), v
 
 
+def normal_curvature(SKL: np.ndarray, n: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Normal curvature ``II(c) / I(c)`` in tangent directions ``c`` (3-D, one per point) with respect to the
+    unit normals ``n``, from derivatives ``SKL`` (as :meth:`NurbsSurface.derivatives`, order 2); ``c`` is
+    written as ``du S_u + dv S_v`` by the 2 x 2 normal equations (vectorized) [DoCarmo1976, sec. 3-2].
+
+    >>> SKL = np.zeros((1, 3, 3, 3)); SKL[0, 1, 0] = [1, 0, 0]; SKL[0, 0, 1] = [0, 1, 0]
+    >>> SKL[0, 2, 0] = [0, 0, 2.0]  # z = u^2: curvature 2 along x, 0 along y
+    >>> normal_curvature(np.repeat(SKL, 2, 0), np.array([[0, 0, 1.0]] * 2), np.array([[3.0, 0, 0], [0, 1.0, 0]]))
+    array([2., 0.])
+    """
+    Su, Sv = SKL[:, 1, 0], SKL[:, 0, 1]
+    E, F, G = (np.einsum("ij,ij->i", a, b) for a, b in ((Su, Su), (Su, Sv), (Sv, Sv)))
+    cu, cv = np.einsum("ij,ij->i", c, Su), np.einsum("ij,ij->i", c, Sv)
+    det = E * G - F * F
+    with np.errstate(invalid="ignore", divide="ignore"):
+        du, dv = (G * cu - F * cv) / det, (E * cv - F * cu) / det
+    L, M, N = (np.einsum("ij,ij->i", SKL[:, k, l], n) for k, l in ((2, 0), (1, 1), (0, 2)))
+    second = L * du * du + 2 * M * du * dv + N * dv * dv
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return second / np.einsum("ij,ij->i", c, c)
+
+
+def classify(gap, angle, jump_rel, size: float, tol_gap: float, tol_angle: float, tol_curv: float) -> str:
+    """The class of a seam from its samples: ``open`` when a gap exceeds ``tol_gap * size``, ``G0`` when an
+    angle (degrees) exceeds ``tol_angle``, ``G1`` when a relative curvature jump exceeds ``tol_curv``, else
+    ``G2``.
+
+    >>> classify([0.0], [0.01], [0.5], 1.0, 1e-6, 0.05, 1e-3)
+    'G1'
+    """
+    if np.max(gap) > tol_gap * size:
+        return "open"
+    if np.max(angle) > tol_angle:
+        return "G0"
+    if np.max(jump_rel) > tol_curv:
+        return "G1"
+    return "G2"
+
+
 def _cross_curvature(s: NurbsSurface, u, v, along_u: bool, n_ref):
     """Normal curvature across the boundary, the normal oriented like ``n_ref``; and the oriented normal."""
     SKL = s.derivatives(u, v, 2)
@@ -78,16 +117,7 @@ def _cross_curvature(s: NurbsSurface, u, v, along_u: bool, n_ref):
     sign = np.where(np.einsum("ij,ij->i", n, n_ref) < 0, -1.0, 1.0)
     n *= sign[:, None]
     T = Sv if along_u else Su  # the boundary's tangent: a u = const side runs along v
-    c = np.cross(n, T)
-    # c = du S_u + dv S_v (least squares in the tangent plane), then II(c) / I(c) with the oriented normal
-    J = np.stack([Su, Sv], axis=-1)  # (m, 3, 2)
-    d = np.linalg.lstsq(J, c[..., None], rcond=None)[0][..., 0] if J.shape[0] == 1 else np.stack(
-        [np.linalg.lstsq(J[i], c[i], rcond=None)[0] for i in range(J.shape[0])])
-    du, dv = d[:, 0], d[:, 1]
-    L, M, N = (np.einsum("ij,ij->i", SKL[:, k, l], n) for k, l in ((2, 0), (1, 1), (0, 2)))
-    second = L * du * du + 2 * M * du * dv + N * dv * dv
-    first = np.einsum("ij,ij->i", c, c)
-    return second / first, n
+    return normal_curvature(SKL, n, np.cross(n, T)), n
 
 
 def find_seams(surfaces, samples: int = 33, match: float = 1e-6, tol_gap: float = 1e-6,
@@ -144,14 +174,7 @@ def _measure(surfaces, ka, sa, ua, va, kb, sb, ub, vb, size, tol_gap, tol_angle,
     # in both): the normal curvature of a direction and of its opposite are equal, so compare directly
     jump = np.abs(ka_c - kb_c)
     scale = np.maximum(np.maximum(np.abs(ka_c), np.abs(kb_c)), 1.0 / size)
-    if gap.max() > tol_gap * size:
-        level = "open"
-    elif angle.max() > tol_angle:
-        level = "G0"
-    elif (jump / scale).max() > tol_curv:
-        level = "G1"
-    else:
-        level = "G2"
+    level = classify(gap, angle, jump / scale, size, tol_gap, tol_angle, tol_curv)
     return Seam(ka, sa, kb, sb, 0.5 * (pa + pb), gap, angle, jump, level)
 
 

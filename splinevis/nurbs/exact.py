@@ -13,7 +13,7 @@ import numpy as np
 
 from .surface import NurbsSurface
 
-__all__ = ["circle_net", "sphere", "torus", "cylinder", "saddle", "CIRCLE_KNOTS"]
+__all__ = ["circle_net", "sphere", "torus", "cylinder", "saddle", "box_faces", "CIRCLE_KNOTS"]
 
 _H = np.sqrt(0.5)
 #: Knots of the 9-point full circle (quarter arcs joined at double knots).
@@ -98,3 +98,20 @@ def saddle(size: float = 1.0) -> NurbsSurface:
     P[..., 2] = sq[:, None] - sq[None, :]
     k = np.array([0, 0, 0, 1, 1, 1], dtype=np.float64)
     return NurbsSurface((2, 2), (k, k), P, name="saddle")
+
+
+def box_faces(a: float = 1.0, b: float = 1.0, c: float = 1.0) -> list:
+    """The six faces of the box ``[0, a] x [0, b] x [0, c]``, bilinear patches with ``S_u x S_v`` pointing out.
+
+    >>> faces = box_faces(2.0, 1.0, 1.0)
+    >>> [f.name for f in faces[:2]], faces[1].normal([0.5], [0.5]).tolist()
+    (['box -z', 'box +z'], [[0.0, 0.0, 1.0]])
+    """
+    P = [[[x, y, z] for z in (0.0, c)] for x in (0.0, a) for y in (0.0, b)]  # P[2 i + j][k]: x_i, y_j, z_k
+    corner = lambda i, j, k: P[2 * i + j][k]  # noqa: E731
+    quads = {  # (p00, p10, p01, p11) with (p10 - p00) x (p01 - p00) outward
+        "-z": ((0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)), "+z": ((0, 0, 1), (1, 0, 1), (0, 1, 1), (1, 1, 1)),
+        "-y": ((0, 0, 0), (1, 0, 0), (0, 0, 1), (1, 0, 1)), "+y": ((0, 1, 0), (0, 1, 1), (1, 1, 0), (1, 1, 1)),
+        "-x": ((0, 0, 0), (0, 0, 1), (0, 1, 0), (0, 1, 1)), "+x": ((1, 0, 0), (1, 1, 0), (1, 0, 1), (1, 1, 1)),
+    }
+    return [NurbsSurface.bilinear(*(corner(*q) for q in qs), name=f"box {side}") for side, qs in quads.items()]

@@ -45,7 +45,7 @@ import numpy as np
 from ..check.judge import FamilyJudge, Finding
 from .model import NurbsModel
 
-__all__ = ["JUDGE"]
+__all__ = ["JUDGE", "occ_outward"]
 
 #: Linear deflection of the baseline mesh, relative to the diagonal of the faces' bounding box. At the check's
 #: close-up (a 300-pixel-high window, zoom 3, pyvista's 30 degree view of the bounding sphere) one pixel is about
@@ -491,3 +491,59 @@ JUDGE = FamilyJudge(
     read=_read, build=_build, baseline=_baseline, accuracy=_accuracy, add=_add,
     description="faces drawn against faces in the file (rhino3dm / OpenCASCADE), and OpenCASCADE's "
                 "BRepMesh at 1e-3 of the diagonal as the baseline, its deviation from the exact surfaces measured")
+
+
+# ------------------------------------------------------------------------- OpenCASCADE's orientation
+def occ_outward(model: NurbsModel, tol: float = 1e-6) -> np.ndarray:
+    """OpenCASCADE's answer: ``+1`` where a face's normal ``S_u x S_v`` points out of the solid its sewn shell
+    bounds, ``-1`` where it points in, ``0`` where the face is not in a closed shell (or not built).
+
+    Needs ``OCP`` (the ``cad`` extra). The faces are built as in the OpenCASCADE judge, sewn
+    (``BRepBuilderAPI_Sewing``), each shell oriented (``ShapeFix_Shell``) and made a solid with outward faces
+    (``ShapeFix_Solid``); a face REVERSED in that solid has its outside behind its surface normal. ``tol`` is
+    the absolute sewing tolerance (gaps of real files need about 1e-4 of the model's size); the independent
+    check of :func:`.orient.orient_faces`.
+
+    >>> from splinevis.nurbs.exact import box_faces
+    >>> from splinevis.nurbs.orient import flip_u
+    >>> faces = box_faces(2.0, 1.0, 1.0)
+    >>> occ_outward(NurbsModel(faces[:5] + [flip_u(faces[5])[0]]), 1e-7).tolist()  # the +x face turned in
+    [1.0, 1.0, 1.0, 1.0, 1.0, -1.0]
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    faces = []
+    for s, loops in zip(model.surfaces, model.trims):
+        try:
+            faces.append(_occ_face(s, loops, tol))
+        except Exception:  # noqa: BLE001 -- a face OpenCASCADE cannot build has no answer (0)
+            faces.append(None)
+    sew = BRepBuilderAPI_Sewing(tol)
+    for f in faces:
+        if f is not None:
+            sew.Add(f)
+    sew.Perform()
+    sewn = sew.SewedShape()
+    out = np.zeros(len(faces))
+    images = [None if f is None else (sew.Modified(f) if sew.IsModified(f) else f) for f in faces]
+    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
+    while shells.More():
+        fix = ShapeFix_Shell(TopoDS.Shell(shells.Current()))
+        fix.Perform()
+        shell = fix.Shell()
+        shells.Next()
+        if not shell.Closed():
+            continue
+        solid = ShapeFix_Solid().SolidFromShell(shell)
+        ex = TopExp_Explorer(solid, TopAbs_FACE)
+        while ex.More():
+            f = ex.Current()
+            ex.Next()
+            for k, img in enumerate(images):
+                if img is not None and img.IsSame(f):
+                    out[k] = -1.0 if f.Orientation() == TopAbs_REVERSED else 1.0
+    return out

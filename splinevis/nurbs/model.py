@@ -88,6 +88,12 @@ class NurbsModel:
     trims : sequence (one per surface) of None or a list of loops (each a list of TrimCurve)
     source : str
         Where the model came from (a file name, "sphere", ...), and what a reader skipped.
+    skipped : dict
+        Entity type -> count of what a reader did not read.
+    report : dict
+        Findings about the model (e.g. ``report["orientation"]`` from
+        :func:`splinevis.nurbs.orient.orient_faces`: faces flipped, shells closed, seams' continuity); empty
+        by default.
 
     Examples
     --------
@@ -103,6 +109,7 @@ class NurbsModel:
     trims: tuple = ()
     source: str = ""
     skipped: dict = field(default_factory=dict)
+    report: dict = field(default_factory=dict)
 
     def __post_init__(self):
         surfaces = tuple(self.surfaces)
