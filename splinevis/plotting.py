@@ -158,7 +158,19 @@ class Plotter(pv.Plotter):
         spline.program = program
         self.add_actor(spline.actor, name=name, reset_camera=True)
         self._spline_actors.append(spline)
+        spline.companions = self._add_companions(model, st, name)
         return spline
+
+    def _add_companions(self, model, style, name) -> list:
+        """Draw a model's plain meshes (``model.companion_meshes()``: e.g. a CAD file's mesh objects) as ordinary
+        smooth-shaded meshes in the style's colour; returns their actors (``SplineActor.companions``)."""
+        actors = []
+        for k, (label, points, triangles) in enumerate(getattr(model, "companion_meshes", lambda: ())()):
+            faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
+            mesh = pv.PolyData(points, faces)
+            actors.append(self.add_mesh(mesh, color=style.color, smooth_shading=True, reset_camera=True,
+                                        name=None if name is None else f"{name} mesh {k} ({label})"))
+        return actors
 
     def add_terrain(self, heights, scheme: str = "C1", style: Style | None = None, *, read_options: dict | None = None,
                     presmooth: int = 0, max_error_px: float | None = None, **options):

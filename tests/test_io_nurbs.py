@@ -116,7 +116,7 @@ def test_g2_against_splipy(tmp_path):
         g.write(curve_factory.circle())
         g.write(volume_factory.cube())
     with pytest.warns(UserWarning, match="1 x 100 \\(spline curve\\), 1 x 700 \\(spline volume\\)"):
-        m = read_nurbs(f)
+        m = read_nurbs(f, orient=False)  # the reader against splipy: the faces as written
     assert m.names == ("surface 0", "surface 1")
     assert m.skipped == {"100 (spline curve)": 1, "700 (spline volume)": 1}
     assert "skipped 1 x 100 (spline curve)" in m.source
@@ -126,7 +126,7 @@ def test_g2_against_splipy(tmp_path):
     circle = "130 1 0 0\n3\n1.5\n0 0 0\n0 0 1\n1 0 0\n0 6.283185307179586\n0\n"
     f.write_text(circle + f.read_text())  # an elementary curve first: skipped through splipy's parser
     with pytest.warns(UserWarning):
-        m = read_nurbs(f)
+        m = read_nurbs(f, orient=False)  # the reader against splipy: the faces as written
     assert len(m) == 2 and m.skipped == {"130 (circle)": 1, "100 (spline curve)": 1, "700 (spline volume)": 1}
     only_curve = tmp_path / "curve.g2"
     with G2(str(only_curve)) as g:
@@ -438,3 +438,174 @@ def test_3dm_face_orientation_is_kept(tmp_path):
             (u0, u1), (v0, v1) = s.domain
             u, v = np.array([(u0 + u1) / 2]), np.array([(v0 + v1) / 3])
             assert sign * np.dot(s.normal(u, v)[0], s.evaluate(u, v)[0] - [1.0, 0.5, 0.5]) > 0, (flip, s.name)
+
+
+def high_degree_surface(p: int, q: int):
+    """A rational Bezier patch of degree (p, q) over [0, 2] x [-1, 1] (OCP), a bumpy dome."""
+    from OCP.collections import Array1_double, Array1_int, Array2_double, Array2_gp_Pnt
+    from OCP.Geom import Geom_BSplineSurface
+    from OCP.gp import gp_Pnt
+
+    poles, weights = Array2_gp_Pnt(1, p + 1, 1, q + 1), Array2_double(1, p + 1, 1, q + 1)
+    for i in range(p + 1):
+        for j in range(q + 1):
+            x, y = 2.0 * i / p, 2.0 * j / q - 1.0
+            poles.SetValue(i + 1, j + 1, gp_Pnt(x, y, 0.6 - 0.3 * (x - 1.0) ** 2 - 0.3 * y ** 2 + 0.05 * ((i + j) % 3)))
+            weights.SetValue(i + 1, j + 1, 1.0 + 0.125 * ((i * j) % 3))
+    uk, um, vk, vm = Array1_double(1, 2), Array1_int(1, 2), Array1_double(1, 2), Array1_int(1, 2)
+    for arr, mult, deg, (a, b) in ((uk, um, p, (0.0, 2.0)), (vk, vm, q, (-1.0, 1.0))):
+        arr.SetValue(1, a)
+        arr.SetValue(2, b)
+        mult.SetValue(1, deg + 1)
+        mult.SetValue(2, deg + 1)
+    return Geom_BSplineSurface(poles, weights, uk, vk, um, vm, p, q)
+
+
+def test_step_faces_of_degree_above_7_are_read(tmp_path):
+    """STEP from automotive CAD carries degrees 8 and more (ec_turbine-A.stp: up to 11); OpenCASCADE allows 25."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    from splinevis.nurbs.basis import MAX_DEGREE
+    from splinevis.nurbs.exact import torus
+    from splinevis.nurbs.program import nurbs_program
+
+    assert MAX_DEGREE == 25
+    for p, q in ((9, 8), (25, 2)):
+        surf = high_degree_surface(p, q)
+        w = STEPControl_Writer()
+        w.Transfer(BRepBuilderAPI_MakeFace(surf, 1e-9).Face(), STEPControl_AsIs)
+        f = tmp_path / f"deg{p}.step"
+        w.Write(str(f))
+        m = read_nurbs(f)
+        s = m.surfaces[0]
+        assert s.degree == (p, q) and s.rational
+        u, v = params(s)
+        close(s.evaluate(u, v), [[(x := surf.Value(a, b)).X(), x.Y(), x.Z()] for a, b in zip(u, v)])
+        # the GPU program sizes its basis arrays by the model's degree, only above the default 7
+        assert nurbs_program(m, subdivisions=1).defines["SV_NURBS_MAX_DEGREE"] == p
+    assert "SV_NURBS_MAX_DEGREE" not in nurbs_program(torus(), subdivisions=1).defines
+
+
+@pytest.mark.gl
+def test_a_degree_9_face_is_drawn_with_the_twins_silhouette():
+    import splinevis
+    from splinevis.gl.camera import pixel_rays
+    from splinevis.nurbs.model import NurbsModel
+    from splinevis.nurbs.program import PROGRAM
+    from splinevis.nurbs.surface import NurbsSurface
+
+    from splinevis.io.nurbs_step import bspline_surface
+
+    s = bspline_surface(high_degree_surface(9, 8), "deg9")
+    assert isinstance(s, NurbsSurface) and s.degree == (9, 8)
+    model = NurbsModel([s])
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_spline(model, lights=1, color="tan")
+    pl.camera_position = [(1.0, -3.5, 3.0), (1.0, 0.0, 0.4), (0, 0, 1)]
+    pl.reset_camera_clipping_range()
+    img = pl.screenshot()
+    depth, matrix = pl.depth_buffer(), pl.camera_matrix()
+    pl.close()
+    assert "#define SV_NURBS_MAX_DEGREE 9" in actor.program_sources["fragment"]
+    gpu_hit = depth < 1.0
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref_hit = PROGRAM.raycast(model, o, d).hit
+    assert gpu_hit.mean() > 0.2 and img[gpu_hit].std() > 5
+    assert (gpu_hit != ref_hit).sum() <= 0.001 * gpu_hit.size
+
+
+def test_iges_brep_solid_186_faces_and_their_trims(tmp_path):
+    """A B-rep solid (186 -> 514 -> 510 faces with 508 loops, no 144), as CAD writes solids: every face is read,
+    and the trims are the face's (the two faces z = 0 and z = 1 keep the hole of radius 1/4 about (1, 1/2))."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.IGESControl import IGESControl_Writer
+
+    from splinevis.io.nurbs_iges import check_iges
+    from splinevis.io.nurbs_step import _quiet_occ
+    from splinevis.nurbs.trim import inside, trim_pieces
+
+    _quiet_occ()
+    box = BRepPrimAPI_MakeBox(2.0, 1.0, 1.0).Shape()
+    cyl = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(1, 0.5, -1), gp_Dir(0, 0, 1)), 0.25, 3.0).Shape()
+    solid = BRepBuilderAPI_NurbsConvert(BRepAlgoAPI_Cut(box, cyl).Shape(), True).Shape()
+    f = tmp_path / "solid.igs"
+    w = IGESControl_Writer("MM", 1)  # B-rep mode: 186 / 514 / 510
+    assert w.AddShape(solid)
+    w.ComputeModel()
+    assert w.Write(str(f))
+    types = [int(line[:8]) for line in f.read_text().splitlines()[::1] if line[72:73] == "D"][::2]
+    assert 186 in types and 510 in types and 144 not in types
+    m = read_quiet(f)
+    assert len(m) == 7 == check_iges(f)[0].expected  # 6 box faces and the hole's wall
+    assert all(n.startswith("186 #") for n in m.names)
+    pieces = trim_pieces(m.trims)
+    holed = 0
+    for k, s in enumerate(m.surfaces):
+        (u0, u1), (v0, v1) = s.domain
+        u, v = (g.ravel() for g in np.meshgrid(np.linspace(u0, u1, 41)[1:-1], np.linspace(v0, v1, 41)[1:-1]))
+        p = s.evaluate(u, v)
+        kept = inside(pieces, k, u, v)
+        if np.ptp(p[:, 2]) < 1e-12 and abs(p[0, 2] - 0.5) == 0.5:  # a face z = 0 or z = 1: the hole cut out
+            r = np.hypot(p[:, 0] - 1.0, p[:, 1] - 0.5)
+            clear = np.abs(r - 0.25) > 0.02  # away from the circle (the loops are exact there, the grid is not)
+            assert np.array_equal(kept[clear], r[clear] > 0.25), s.name
+            holed += 1
+        else:
+            assert kept.all(), s.name
+    assert holed == 2
+
+
+def iges_text(entities) -> str:
+    """A fixed-format IGES file of ``entities`` ``(type, parameters, form, subordinate)`` (directory entry 2k + 1
+    for entity k; parameters as written, pointers as ``"#k"`` for entity k)."""
+    glob = "1H,,1H;,4Htest,8Htest.igs,4Htest,4Htest,32,38,6,308,15,4Htest,1.,2,2HMM,1,1.,15H20260101.000000,1E-06,10.,4Htest,4Htest,11,0,15H20260101.000000;"
+    g = [glob[i:i + 72] for i in range(0, len(glob), 72)]
+    d, p = [], []
+    for k, (t, prm, form, sub) in enumerate(entities):
+        text = ",".join(str(2 * int(x[1:]) + 1) if isinstance(x, str) and x.startswith("#") else repr(float(x))
+                        if isinstance(x, float) else str(x) for x in [t, *prm]) + ";"
+        chunks = [text[i:i + 64] for i in range(0, len(text), 64)]
+        de = 2 * k + 1
+        d.append(f"{t:8d}{len(p) + 1:8d}{0:8d}{0:8d}{0:8d}{0:8d}{0:8d}{0:8d}00{sub:02d}0000")
+        d.append(f"{t:8d}{0:8d}{0:8d}{len(chunks):8d}{form:8d}{'':8}{'':8}{'':8}{0:8d}")
+        p += [f"{c:64}{de:8d}" for c in chunks]
+    lines = [f"{'test':72}S{1:7d}"] + [f"{x:72}G{i:7d}" for i, x in enumerate(g, 1)]
+    lines += [f"{x:72}D{i:7d}" for i, x in enumerate(d, 1)] + [f"{x:72}P{i:7d}" for i, x in enumerate(p, 1)]
+    lines.append(f"S{1:7d}G{len(g):7d}D{len(d):7d}P{len(p):7d}".ljust(72) + f"T{1:7d}")
+    return "\n".join(lines) + "\n"
+
+
+def test_iges_bounded_surface_143(tmp_path):
+    """A 143 bounded surface (a 141 boundary of model-space 126 curves, each with its parameter-space 126) on a
+    bilinear 128 square [0, 2]^2: the triangle (0, 0), (2, 0), (0, 2) is what is read."""
+    from splinevis.io.nurbs_iges import check_iges
+    from splinevis.nurbs.trim import inside, trim_pieces
+
+    corners = [(0.0, 0.0), (2.0, 0.0), (0.0, 2.0)]
+    square = (1, 1, 1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, *[1.0] * 4,  # K1 K2 M1 M2, PROP1-5, knots, weights
+              0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 2.0, 2.0, 0.0, 0.0, 1.0, 0.0, 1.0)
+    entities = [(128, square, 0, 1)]
+    for i, (a, b) in enumerate(zip(corners, corners[1:] + corners[:1])):
+        for z in (0.0, 0.0):  # the model-space curve, then the parameter-space one (the square is x = u, y = v)
+            entities.append((126, (1, 1, 1, 0, 1, 0, 0, 0, 1, 1, 1.0, 1.0, *a, z, *b, z, 0, 1, 0, 0, 1), 0, 1))
+    n = len(corners)
+    boundary = (1, 1, "#0", n, *[x for i in range(n) for x in (f"#{1 + 2 * i}", 1, 1, f"#{2 + 2 * i}")])
+    entities.append((141, boundary, 0, 1))
+    entities.append((143, (1, "#0", 1, f"#{len(entities) - 1}"), 0, 0))
+    f = tmp_path / "bounded.igs"
+    f.write_text(iges_text(entities))
+    assert not check_iges(f)[0] and check_iges(f)[0].expected == 1
+    m = read_quiet(f, backend="ocp")
+    assert len(m) == 1 and m.names == (f"143 #{2 * len(entities) - 1}",) and m.trims[0] is not None
+    s = m.surfaces[0]
+    u, v = params(s, 400)
+    close(s.evaluate(u, v), np.column_stack([u, v, 0 * u]) * (2.0 / np.array([*np.ptp(s.domain, axis=1), 1.0])))
+    kept = inside(trim_pieces(m.trims), 0, u, v)
+    (u0, u1), (v0, v1) = s.domain
+    x, y = 2 * (u - u0) / (u1 - u0), 2 * (v - v0) / (v1 - v0)
+    clear = np.abs(x + y - 2.0) > 1e-9
+    assert np.array_equal(kept[clear], (x + y < 2.0)[clear])

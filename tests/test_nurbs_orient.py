@@ -7,7 +7,7 @@ import pytest
 from datasets_synthetic.nurbs_joins import joined_pair
 from splinevis.nurbs.exact import CIRCLE_KNOTS, circle_net, cylinder
 from splinevis.nurbs.model import NurbsModel, TrimCurve
-from splinevis.nurbs.judge import occ_outward
+from splinevis.nurbs.occ_faces import occ_outward
 from splinevis.nurbs.orient import flip_u, orient_faces
 from splinevis.nurbs.shell_volume import signed_volumes
 from splinevis.nurbs.surface import NurbsSurface

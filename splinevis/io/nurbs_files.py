@@ -3,12 +3,13 @@
 :func:`read_nurbs` picks the reader by the file name extension:
 
 * ``.3dm`` -- Rhino files through ``rhino3dm`` (:mod:`.nurbs_3dm`),
-* ``.igs .iges`` -- IGES 128 (rational B-spline surface) and 144 (trimmed surface) through OpenCASCADE
-  (``OCP``, the optional extra ``pip install cadquery-ocp-novtk``) when installed, else ``pyiges``
-  (:mod:`.nurbs_iges`),
-* ``.stp .step`` -- STEP B-spline faces through OCP only (:mod:`.nurbs_step`),
+* ``.igs .iges`` -- IGES 128 (rational B-spline surface), 144 (trimmed surface), 143 (bounded surface) and
+  186 / 514 / 510 B-reps through OpenCASCADE (``OCP``, the optional extra ``pip install cadquery-ocp-novtk``)
+  when installed, else 128 and 144 through ``pyiges`` (:mod:`.nurbs_iges`),
+* ``.stp .step`` -- STEP faces (B-spline, and analytic ones converted to NURBS) through OCP only
+  (:mod:`.nurbs_step`),
 * ``.g2`` (splipy / GoTools), ``.json`` (geomdl ``shape.data``) and ``.bpt`` (Newell's teapot Bezier
-  patches) -- text formats (:mod:`.nurbs_text`).
+  patches) -- text formats (:mod:`.nurbs_text`, :mod:`.nurbs_g2`).
 
 Conventions kept by every reader
 --------------------------------
@@ -21,6 +22,10 @@ Conventions kept by every reader
   supported surface at all raises a ValueError listing what it contained.
 * Invalid data (zero or negative weights, bad knots) raise the model's ValueError prefixed with the file
   and the entity.
+* IGES and STEP files are checked for damage before they are read (lines lost or garbled, cut off,
+  references to nothing): a damaged file raises :class:`~.nurbs_common.DamagedFileError` (a ValueError)
+  naming the file, what it promised and what was found; ``read_nurbs(path, partial=True)`` reads the intact
+  faces and reports the lost ones in a UserWarning, ``NurbsModel.skipped`` and ``NurbsModel.source``.
 """
 
 from __future__ import annotations
@@ -36,22 +41,36 @@ __all__ = ["read_nurbs", "NURBS_EXTENSIONS"]
 #: File name extensions :func:`read_nurbs` reads, and by what.
 NURBS_EXTENSIONS = {
     ".3dm": "Rhino 3DM (rhino3dm)",
-    ".igs": "IGES 128/144 (OCP, else pyiges)",
-    ".iges": "IGES 128/144 (OCP, else pyiges)",
-    ".stp": "STEP B-spline faces (OCP)",
-    ".step": "STEP B-spline faces (OCP)",
+    ".igs": "IGES 128/143/144/186 (OCP, else pyiges: 128/144)",
+    ".iges": "IGES 128/143/144/186 (OCP, else pyiges: 128/144)",
+    ".stp": "STEP faces (OCP)",
+    ".step": "STEP faces (OCP)",
     ".g2": "GoTools/splipy G2 text",
     ".json": "geomdl JSON (shape.data)",
     ".bpt": "Bezier patches (Newell teapot format)",
 }
 
 
-def read_nurbs(path) -> NurbsModel:
+def read_nurbs(path, partial: bool = False, orient: bool | None = None) -> NurbsModel:
     """Read a NURBS model from a file; the reader is chosen by the extension (see :data:`NURBS_EXTENSIONS`).
 
     Parameters
     ----------
     path : str or path-like
+    partial : bool
+        For IGES and STEP files, whose structure is checked before reading: a damaged file (an IGES
+        directory entry pointing past the parameter section, garbled or missing lines, a cut file; a STEP
+        ``#n`` that points nowhere, a cut file) raises :class:`~.nurbs_common.DamagedFileError` naming the
+        file, what it promised and what was found (False), or is read in part (True): the intact faces,
+        with the lost ones in a UserWarning, ``NurbsModel.skipped`` (``"damaged <entity>"``) and
+        ``NurbsModel.source``.
+    orient : bool or None
+        Give the faces of each closed shell one outward orientation and measure the seams
+        (:func:`splinevis.nurbs.orient.orient_faces`): the report is ``model.report["orientation"]`` (faces
+        flipped, shells closed or open, each seam's G0/G1/G2 class with its kink angle). None (default): for
+        the formats whose faces carry no outside (IGES, the text formats) or may come without a shell (STEP's
+        bare surfaces), not for Rhino files (each Brep face's orientation is applied by the reader, and a
+        SubD's patches follow its control net). False keeps the faces as the file has them.
 
     Returns
     -------
@@ -86,12 +105,19 @@ def read_nurbs(path) -> NurbsModel:
     require_regular_file(path, "NURBS")
     if ext == ".3dm":
         from .nurbs_3dm import read_3dm
-        return read_3dm(path)
-    if ext in (".igs", ".iges"):
+        model = read_3dm(path)
+    elif ext in (".igs", ".iges"):
         from .nurbs_iges import read_iges
-        return read_iges(path)
-    if ext in (".stp", ".step"):
+        model = read_iges(path, partial=partial)
+    elif ext in (".stp", ".step"):
         from .nurbs_step import read_step
-        return read_step(path)
-    from .nurbs_text import read_bpt, read_g2, read_geomdl_json
-    return {".g2": read_g2, ".json": read_geomdl_json, ".bpt": read_bpt}[ext](path)
+        model = read_step(path, partial=partial)
+    else:
+        from .nurbs_g2 import read_g2
+        from .nurbs_text import read_bpt, read_geomdl_json
+        model = {".g2": read_g2, ".json": read_geomdl_json, ".bpt": read_bpt}[ext](path)
+    if orient or (orient is None and ext != ".3dm"):
+        from ..nurbs.orient import orient_faces
+
+        model = orient_faces(model)[0]
+    return model

@@ -1,11 +1,14 @@
-"""NURBS surfaces from IGES files: entity 128 (rational B-spline surface) and 144 (trimmed surface).
+"""NURBS surfaces from IGES files: 128 (rational B-spline surface), 144 (trimmed surface), 143 (bounded
+surface), 186 / 514 / 510 B-rep solids and shells (faces without 144), after a check of the file's structure.
 
 Two back ends, chosen at call time:
 
 * **OpenCASCADE** (``OCP``, optional extra ``cad``: ``pip install cadquery-ocp-novtk``) when it imports:
-  every independent (or only logically dependent, as in a 402 group) surface-bearing entity (128, 144, 143, 186/514/510 B-reps, ...) is transferred on its
-  own and its B-spline faces read with :func:`.nurbs_step.shape_faces` (trim loops from the faces'
-  pcurves; transformation matrices applied by OCP).
+  every independent (or only logically dependent, as in a 402 group) surface-bearing entity (128, 143, 144,
+  186 / 514 / 510 B-reps, analytic surfaces 190-198, ...) is transferred on its own and its faces read with
+  :func:`.nurbs_step.shape_faces` (trim loops from the faces' pcurves; analytic faces converted to NURBS;
+  transformation matrices applied by OCP). An entity OpenCASCADE cannot transfer is counted in ``skipped``
+  as ``"<type> (<name>), not transferred"``.
 * **pyiges** (light, pure Python) otherwise: independent 128 entities, and 144 entities whose surface
   is a 128 and whose boundaries (142) have parameter-space curves (``BPTR``) of type 126 or 102
   (composite of 126) -- each 126 in the ``(u, v)`` plane (x = u, y = v). A 144 whose outer boundary is
@@ -18,49 +21,39 @@ Control points of a 128 run over the first (u) index fastest (IGES 5.3, sec. 4.2
 the entity label when the file has one, else ``"<type> #<directory sequence number>"`` (for a B-rep
 with several faces: ``"<name> face <k>"``). Independent entities of other types are counted in
 ``skipped`` by IGES type number and name.
+
+Damaged files
+-------------
+OpenCASCADE and pyiges read a damaged IGES file without a word and return whatever they could parse (a part
+cut in half, or with lines overwritten, loads some of its faces). :func:`check_iges` therefore reads the
+fixed-format file's structure first (fast: no geometry): every line's section letter and sequence number
+(columns 73-80), the terminate record's counts, each directory entry (its two lines, its type on both) and
+its parameter record (the lines it points to exist, carry the entry's back pointer in columns 65-72, start
+with the entity type and end with the record delimiter; the parameters of geometry and topology entities
+are numbers) and the directory pointers in the records of the entities faces are made of (102, 141-144,
+186, 504-514, 108-122, 190-198; transformation matrices). A face is lost when anything it reaches is
+broken. The problems are told in the file's terms ("directory entry 57 (type 128) points to parameter
+lines 1201-1230, the parameter section ends at line 900 (file line 1107)"). ``read_iges`` raises a
+:class:`~.nurbs_common.DamagedFileError` with them, or with ``partial=True`` transfers only the intact
+face-bearing entities (from a copy whose lines are put back in sequence when lines were lost: a lost
+directory entry becomes a null entity, so that every other entry keeps its number) and reports the rest
+(:func:`.nurbs_common.build_model`). The compressed ASCII form (``C`` in column 73) is not checked.
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
 from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
-from .nurbs_common import build_model, checked
+from .nurbs_common import Damage, DamagedFileError, build_model, checked
+from .nurbs_iges_check import _STRUCTURE_TYPES, _SURFACE_TYPES, IGES_TYPES, _child, _type_key, check_iges
 
-__all__ = ["read_iges", "IGES_TYPES"]
+__all__ = ["read_iges", "check_iges", "IGES_TYPES"]
 
-#: IGES entity type names, for the messages and ``skipped``.
-IGES_TYPES = {
-    100: "circular arc", 102: "composite curve", 104: "conic arc", 106: "copious data", 108: "plane",
-    110: "line", 112: "parametric spline curve", 114: "parametric spline surface", 116: "point",
-    118: "ruled surface", 120: "surface of revolution", 122: "tabulated cylinder", 123: "direction",
-    124: "transformation matrix", 126: "rational B-spline curve", 128: "rational B-spline surface",
-    130: "offset curve", 140: "offset surface", 141: "boundary", 142: "curve on surface",
-    143: "bounded surface", 144: "trimmed surface", 186: "manifold solid B-rep", 190: "plane surface",
-    192: "cylindrical surface", 194: "conical surface", 196: "spherical surface", 198: "toroidal surface",
-    212: "general note", 308: "subfigure definition", 314: "color", 402: "associativity", 406: "property",
-    408: "subfigure instance", 502: "vertex list", 504: "edge list", 508: "loop", 510: "face", 514: "shell",
-}
-
-# Independent entities that carry surfaces (OCP transfers them to faces).
-_SURFACE_TYPES = {108, 114, 118, 120, 122, 128, 140, 143, 144, 186, 190, 192, 194, 196, 198, 510, 514}
-# Structure, not geometry: neither read nor reported as skipped.
-_STRUCTURE_TYPES = {124, 314, 402, 406}
-
-
-def _child(subordinate: int) -> bool:
-    """Physically dependent (01, or 03: both): read through its parent. Logically dependent (02) entities,
-    e.g. the 144s of a 402 group, stand alone."""
-    return subordinate in (1, 3)
-
-
-def _type_key(t: int) -> str:
-    return f"{t} ({IGES_TYPES.get(t, 'entity')})"
-
-
-def read_iges(path, backend: str | None = None) -> NurbsModel:
+def read_iges(path, backend: str | None = None, partial: bool = False) -> NurbsModel:
     """Read the 128/144 surfaces of an IGES file (OCP when installed, else pyiges; see the module notes).
 
     Parameters
@@ -68,6 +61,15 @@ def read_iges(path, backend: str | None = None) -> NurbsModel:
     path : str or path-like
     backend : {None, "ocp", "pyiges"}
         Force a back end (None: OCP if it imports, else pyiges).
+    partial : bool
+        A damaged file (module notes, "Damaged files"): False raises :class:`~.nurbs_common.DamagedFileError`
+        naming what is broken; True reads the intact faces and reports the lost ones (warning, ``skipped``,
+        ``source``).
+
+    Raises
+    ------
+    DamagedFileError
+        The file's structure is broken (and ``partial`` is False).
 
     Examples
     --------
@@ -88,18 +90,33 @@ def read_iges(path, backend: str | None = None) -> NurbsModel:
     path = Path(path)
     if backend not in (None, "ocp", "pyiges"):
         raise ValueError(f"backend must be None, 'ocp' or 'pyiges', got {backend!r}.")
+    damage, lost, repaired = check_iges(path)
+    if damage and not partial:
+        raise DamagedFileError(path, damage)
+    if repaired is None:
+        return _read_backend(path, path, backend, damage, lost)
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="splinevis-iges-") as folder:  # the lines put back in place
+        fixed = Path(folder) / "repaired.igs"
+        fixed.write_text(repaired, encoding="latin-1")
+        return _read_backend(fixed, path, backend, damage, lost)
+
+
+def _read_backend(file: Path, path: Path, backend, damage, lost):
+    """Read ``file`` (``path`` itself or its repaired copy; ``path`` for names and messages)."""
     if backend in (None, "ocp"):
         from .nurbs_step import OCP_HINT, ocp_available
 
         if ocp_available():
-            return _read_ocp(path)
+            return _read_ocp(file, path, damage, lost)
         if backend == "ocp":
             raise ImportError(f"{path}: backend='ocp' needs OpenCASCADE's Python bindings: {OCP_HINT}.")
-    return _read_pyiges(path)
+    return _read_pyiges(file, path, damage, lost)
 
 
 # --------------------------------------------------------------------------------------------------
-def _read_ocp(path: Path):
+def _read_ocp(file: Path, path: Path, damage: Damage, lost: set):
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.IGESControl import IGESControl_Reader
 
@@ -107,7 +124,7 @@ def _read_ocp(path: Path):
 
     _quiet_occ()
     reader = IGESControl_Reader()
-    if reader.ReadFile(str(path)) != IFSelect_RetDone:
+    if reader.ReadFile(str(file)) != IFSelect_RetDone:
         raise ValueError(f"{path}: OpenCASCADE could not read this file as IGES; is it a valid IGES 5.x file?")
     model = reader.Model()
     surfaces, trims, skipped, contents, converted = [], [], {}, {}, {}
@@ -122,18 +139,24 @@ def _read_ocp(path: Path):
         if t not in _SURFACE_TYPES:
             skipped[_type_key(t)] = skipped.get(_type_key(t), 0) + 1
             continue
+        if 2 * i - 1 in lost:  # reaches a broken record: counted in the damage
+            continue
         before = reader.NbShapes()
         if not reader.TransferOne(i) or reader.NbShapes() == before:
             skipped[f"{_type_key(t)}, not transferred"] = skipped.get(f"{_type_key(t)}, not transferred", 0) + 1
             continue
-        s, tr = shape_faces(reader.Shape(reader.NbShapes()), path, skipped, prefix=name, converted=converted)
+        shape = reader.Shape(reader.NbShapes())
+        if shape.IsNull():  # OpenCASCADE gave up on the entity (its check list says why)
+            skipped[f"{_type_key(t)}, not transferred"] = skipped.get(f"{_type_key(t)}, not transferred", 0) + 1
+            continue
+        s, tr = shape_faces(shape, path, skipped, prefix=name, converted=converted)
         surfaces += s
         trims += tr
-    return build_model(path, "IGES (OCP)" + converted_note(converted), surfaces, trims, skipped, contents)
+    return build_model(path, "IGES (OCP)" + converted_note(converted), surfaces, trims, skipped, contents, damage)
 
 
 # --------------------------------------------------------------------------------------------------
-def _read_pyiges(path: Path):
+def _read_pyiges(file: Path, path: Path, damage: Damage, lost: set):
     import contextlib
     import io
 
@@ -142,7 +165,10 @@ def _read_pyiges(path: Path):
     out = io.StringIO()
     try:
         with contextlib.redirect_stdout(out):  # pyiges prints a line per entity it cannot parse
-            iges = pyiges.read(str(path))
+            iges = pyiges.read(str(file))
+        # pyiges drops the entities it cannot parse from its list after indexing them: the pointers of every
+        # later entity would point one entity too far; index them again
+        iges._pointers = {e.sequence_number: k for k, e in enumerate(iges._entities)}
     except (RuntimeError, ValueError, IndexError, KeyError) as err:
         raise ValueError(f"{path}: pyiges could not parse this file as IGES ({type(err).__name__}: {err}).") from None
     surfaces, trims, skipped, contents = [], [], {}, {}
@@ -153,6 +179,8 @@ def _read_pyiges(path: Path):
         if _child((status // 10000) % 100) or t in _STRUCTURE_TYPES:
             continue
         name = (e.d.get("entity_label") or "").strip() or f"{t} #{e.sequence_number}"
+        if e.sequence_number in lost:  # reaches a broken record: counted in the damage
+            continue
         if t == 128:
             surfaces.append(_surface_128(iges, e, path, name, _transform(iges, e)))
             trims.append(None)
@@ -162,9 +190,15 @@ def _read_pyiges(path: Path):
             trims.append(loops)
         else:
             skipped[_type_key(t)] = skipped.get(_type_key(t), 0) + 1
-    if "Warning" in out.getvalue():
-        skipped["entities pyiges could not parse"] = out.getvalue().count("Warning")
-    return build_model(path, "IGES (pyiges)", surfaces, trims, skipped, contents)
+    failed = [int(n) for n in re.findall(r"ending on line (\d+)", out.getvalue())]
+    if damage:  # the broken records (in the damage already) are no news
+        lines = file.read_text(encoding="latin-1").splitlines()
+        records = getattr(damage, "records", set())
+        failed = [n for n in failed if not (n <= len(lines) and lines[n - 1][64:72].strip().isdigit()
+                                            and int(lines[n - 1][64:72]) in records)]
+    if failed or ("Warning" in out.getvalue() and not damage):
+        skipped["entities pyiges could not parse"] = max(len(failed), 1)
+    return build_model(path, "IGES (pyiges)", surfaces, trims, skipped, contents, damage)
 
 
 def _transform(iges, e) -> np.ndarray | None:

@@ -11,7 +11,11 @@ unrolled to their non-periodic form (same points). The face's wires become its t
 curve on the surface (its "pcurve", trimmed to the edge's range) converted to a 2-D B-spline with
 ``Geom2dConvert``, in the surface's own ``(u, v)`` domain. A reversed face (its outside the surface's back)
 is mirrored in v (trims with it) so that ``S_u x S_v`` points out. Faces on other surfaces (planes,
-cylinders, ... not converted to NURBS by the writer) are counted in ``skipped`` as ``"face on Geom_Plane"``.
+cylinders, cones, spheres, tori, extrusions, revolutions, offsets: not converted to NURBS by the writer) are
+converted exactly by OpenCASCADE (``BRepBuilderAPI_NurbsConvert``) and counted in ``source``; a face it cannot
+convert is counted in ``skipped`` as ``"face on <surface type>"``. Degrees up to OpenCASCADE's 25 are read
+(:data:`splinevis.nurbs.basis.MAX_DEGREE`); pcurves above degree 3 are approximated by cubics within 1e-9 of
+the domain (:func:`_cubic_pcurve`).
 
 Names
 -----
@@ -30,6 +34,23 @@ every instance of a part carries the part's names. The shape itself is the XCAF 
 the XCAF document cannot be built (its modules missing, the transfer failing), the file is read with the
 plain ``STEPControl_Reader``: faces are named ``"face <k>"``, a UserWarning says why and ``source`` says
 ``"names not read"``.
+
+Damaged files
+-------------
+OpenCASCADE's STEP reader does not say when a file is damaged: a cut file loads the faces before the cut,
+and a ``#123`` that points nowhere can crash the Python process. :func:`check_step` therefore scans the
+data section first (strings and comments masked, so no ``;`` or ``#`` inside them counts): every instance
+``#n = ...;`` with its references, instances defined twice, garbled instances (unbalanced parentheses),
+references to instances the file does not define, and a file that ends without ``ENDSEC;`` /
+``END-ISO-10303-21;`` (cut off). A face (``ADVANCED_FACE``, ``FACE_SURFACE``) is lost when anything it
+reaches is broken; the faces a shell lists but the file never defines are counted too. ``read_step`` raises
+a :class:`~.nurbs_common.DamagedFileError` naming them ("#48 (ADVANCED_FACE, line 69) refers to #9999999"),
+or with ``partial=True`` reads a copy without the lost instances: containers (shells, representations,
+layers) keep their lists without the lost members, any other instance that refers to a lost one is dropped
+with it (a face is read whole or not at all), and intact solids and surface models whose representation or
+product was lost are given a new one (in millimetres when the units were lost too, which the damage report
+says). The copy is checked again before OpenCASCADE sees it. When no face is intact, the error is raised
+even with ``partial=True``.
 """
 
 from __future__ import annotations
@@ -40,9 +61,10 @@ from pathlib import Path
 import numpy as np
 
 from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
-from .nurbs_common import build_model, checked, flip_v
+from .nurbs_common import DamagedFileError, build_model, checked, flip_v
+from .nurbs_step_check import check_step
 
-__all__ = ["read_step", "ocp_available", "shape_to_model", "shape_faces", "bspline_surface", "OCP_HINT"]
+__all__ = ["read_step", "check_step", "ocp_available", "shape_to_model", "shape_faces", "bspline_surface", "OCP_HINT"]
 
 #: What to install for OCP.
 OCP_HINT = "pip install cadquery-ocp-novtk (or: pip install 'splinevis[cad]')"
@@ -69,18 +91,29 @@ def _quiet_occ() -> None:
         printer.SetTraceLevel(Message_Gravity.Message_Fail)
 
 
-def read_step(path) -> NurbsModel:
-    """Read the B-spline faces of a STEP file (with their trim loops and stored names) through OCP.
+def read_step(path, partial: bool = False) -> NurbsModel:
+    """Read the faces of a STEP file (with their trim loops and stored names) through OCP.
 
     Names come from the file's XCAF document: a face's own name, else ``"<part> / face <k>"``, else
     ``"face <k>"`` (see the module notes); without XCAF the plain reader is used, with a warning.
+
+    Parameters
+    ----------
+    path : str or path-like
+    partial : bool
+        A damaged file (module notes, "Damaged files"): False raises
+        :class:`~.nurbs_common.DamagedFileError` naming what is broken; True reads the intact faces (from a
+        copy without the lost instances) and reports the lost ones (warning, ``skipped``, ``source``).
 
     Raises
     ------
     ImportError
         OCP is not installed (``pip install cadquery-ocp-novtk``).
+    DamagedFileError
+        The file is damaged (and ``partial`` is False): cut off, a ``#n`` that points nowhere, a garbled
+        instance.
     ValueError
-        The file cannot be read, or holds no B-spline face.
+        The file cannot be read, or holds no face.
 
     Examples
     --------
@@ -99,13 +132,31 @@ def read_step(path) -> NurbsModel:
     """
     path = Path(path)
     try:
-        from OCP.IFSelect import IFSelect_RetDone
-        from OCP.STEPControl import STEPControl_Reader
+        import OCP.STEPControl  # noqa: F401
     except ImportError:
         raise ImportError(f"{path}: reading STEP files needs OpenCASCADE's Python bindings (OCP): {OCP_HINT}.") from None
+    damage, repaired = check_step(path)
+    if damage and (not partial or damage.lost_total == damage.expected):
+        # OpenCASCADE may crash on a dangling reference: it never sees a damaged file
+        raise DamagedFileError(path, damage)
+    if repaired is None:
+        return _read_step(path, path, damage)
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="splinevis-step-") as folder:
+        fixed = Path(folder) / "repaired.stp"
+        fixed.write_text(repaired(), encoding="latin-1")
+        return _read_step(fixed, path, damage)
+
+
+def _read_step(file: Path, path: Path, damage) -> NurbsModel:
+    """Read ``file`` (``path`` itself or its repaired copy; ``path`` for names and messages)."""
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
     _quiet_occ()
     try:
-        shape, names = _read_xcaf(path)
+        shape, names = _read_xcaf(file, path)
     except _Unreadable:
         raise
     except Exception as err:  # noqa: BLE001 -- any XCAF failure: read the geometry without names, and say so
@@ -113,13 +164,14 @@ def read_step(path) -> NurbsModel:
         warnings.warn(f"{path}: face names not read, OpenCASCADE's XCAF document could not be built ({why}); "
                       "read with the plain STEPControl_Reader.", UserWarning, stacklevel=2)
         reader = STEPControl_Reader()
-        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+        if reader.ReadFile(str(file)) != IFSelect_RetDone:
             raise _Unreadable(_unreadable(path)) from None
         reader.TransferRoots()
-        return shape_to_model(reader.OneShape(), path, f"STEP (OCP, plain reader; names not read: {why})", {})
+        return shape_to_model(reader.OneShape(), path, f"STEP (OCP, plain reader; names not read: {why})", {},
+                              damage)
     skipped, converted = {}, {}
     surfaces, trims = shape_faces(shape, path, skipped, names=names.name, converted=converted)
-    return build_model(path, "STEP (OCP)" + converted_note(converted), surfaces, trims, skipped)
+    return build_model(path, "STEP (OCP)" + converted_note(converted), surfaces, trims, skipped, damage=damage)
 
 
 class _Unreadable(ValueError):
@@ -130,9 +182,9 @@ def _unreadable(path) -> str:
     return f"{path}: OpenCASCADE could not read this file as STEP; is it a valid ISO 10303-21 file?"
 
 
-def _read_xcaf(path: Path):
-    """``(shape, FaceNames)``: the file through ``STEPCAFControl_Reader`` into an XCAF document; the shape is
-    the reader's own ``STEPControl_Reader`` result (what the plain path reads)."""
+def _read_xcaf(file: Path, path: Path):
+    """``(shape, FaceNames)``: ``file`` through ``STEPCAFControl_Reader`` into an XCAF document; the shape is
+    the reader's own ``STEPControl_Reader`` result (what the plain path reads); ``path`` for messages."""
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.Interface import Interface_Static
     from OCP.STEPCAFControl import STEPCAFControl_Reader
@@ -147,7 +199,7 @@ def _read_xcaf(path: Path):
     before = Interface_Static.IVal_s(key)
     Interface_Static.SetIVal_s(key, 1)
     try:
-        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+        if reader.ReadFile(str(file)) != IFSelect_RetDone:
             raise _Unreadable(_unreadable(path))
         app = XCAFApp_Application.GetApplication_s()
         doc = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
@@ -291,7 +343,7 @@ def _faces(shape) -> list:
     return faces
 
 
-def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
+def shape_to_model(shape, path, kind: str, skipped: dict, damage=None) -> NurbsModel:
     """Turn an OCP shape's faces into a NurbsModel (analytic faces converted, :func:`shape_faces`; see the
     module notes).
 
@@ -304,6 +356,8 @@ def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
         The format and library, for ``source``.
     skipped : dict
         What the caller already skipped (entity type -> count); faces on other surfaces are added.
+    damage : Damage, optional
+        What a partial read of a damaged file lost (:func:`.nurbs_common.build_model`).
 
     Examples
     --------
@@ -314,7 +368,7 @@ def shape_to_model(shape, path, kind: str, skipped: dict) -> NurbsModel:
     """
     skipped, converted = dict(skipped), {}
     surfaces, trims = shape_faces(shape, path, skipped, converted=converted)
-    return build_model(path, kind + converted_note(converted), surfaces, trims, skipped)
+    return build_model(path, kind + converted_note(converted), surfaces, trims, skipped, damage=damage)
 
 
 def shape_faces(shape, path, skipped: dict, prefix: str = "", names=None, converted=None) -> tuple:
@@ -500,3 +554,6 @@ def _cubic_pcurve(bs, path, name):
         raise ValueError(f"{path}: {name}: a trim curve of degree {bs.Degree()} could not be brought to a cubic "
                          f"within {tol:.3g} (OpenCASCADE's approximation reached {approx.MaxError():.3g}).")
     return approx.Curve()
+
+
+# --------------------------------------------------------------------------------------------------

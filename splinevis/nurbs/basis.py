@@ -2,7 +2,7 @@
 
 Names follow [PieglTiller1997, ch. 2]: ``find_span`` (A2.1), ``basis_funs`` (A2.2), ``ders_basis_funs``
 (A2.3). Each takes an array of parameters and returns one row per parameter; the loops run over the degree
-(at most 7 here), never over the parameters. This is the float64 twin of ``glsl/lib/nurbs/basis.glsl``.
+(at most MAX_DEGREE = 25), never over the parameters. This is the float64 twin of ``glsl/lib/nurbs/basis.glsl``.
 
 Conventions
 -----------
@@ -19,14 +19,15 @@ import numpy as np
 
 __all__ = ["check_knots", "find_span", "basis_funs", "ders_basis_funs", "MAX_DEGREE", "at_fraction", "into_domain"]
 
-#: Highest degree handled (per direction).
-MAX_DEGREE = 7
+#: Highest degree handled (per direction): OpenCASCADE's limit (``Geom_BSplineSurface::MaxDegree()``), as STEP
+#: files from automotive CAD carry degrees 8-9 and more; the GPU program sizes its arrays by the model's degree.
+MAX_DEGREE = 25
 
 
 def check_knots(knots, degree: int, count: int, name: str = "knots") -> np.ndarray:
     """Validate a knot vector for ``count`` control points of degree ``degree``; return it as float64.
 
-    Checks: degree 1..7, ``len(knots) == count + degree + 1``, finite, non-decreasing, no knot of
+    Checks: degree 1..MAX_DEGREE, ``len(knots) == count + degree + 1``, finite, non-decreasing, no knot of
     multiplicity above ``degree + 1`` (``degree`` inside the domain: a C(-1) break is two patches), and a
     domain of positive length.
 

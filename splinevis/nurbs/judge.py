@@ -44,8 +44,9 @@ import numpy as np
 
 from ..check.judge import FamilyJudge, Finding
 from .model import NurbsModel
+from .occ_faces import _diagonal, _model_shape
 
-__all__ = ["JUDGE", "occ_outward"]
+__all__ = ["JUDGE"]
 
 #: Linear deflection of the baseline mesh, relative to the diagonal of the faces' bounding box. At the check's
 #: close-up (a 300-pixel-high window, zoom 3, pyvista's 30 degree view of the bounding sphere) one pixel is about
@@ -66,6 +67,9 @@ MAX_LISTED = 6
 _STEP = (".stp", ".step")
 _IGES = (".igs", ".iges")
 _NOT_NURBS = ("SubD", "Mesh")
+#: SubD patches whose corners lie farther than this share of the diagonal from Rhino's limit points: WARN
+#: (the exact patches' corners are limit points to rounding; approximate ones keep their corners on them too).
+SUBD_WARN = 1e-6
 
 
 @dataclass
@@ -73,7 +77,9 @@ class NurbsFile:
     """What :func:`_read` hands on: the model, the faces counted in the file and by what.
 
     ``face_names``: the faces' names by the reader's naming rule where the counter can give them (3DM), else
-    None; ``not_nurbs``: object kind -> count of surfaces that are not NURBS (SubD, Mesh); ``shape``: the
+    None; ``not_nurbs``: object kind -> count of surfaces that are not NURBS (SubD, Mesh); ``subd_names``,
+    ``mesh_names``: the SubD objects (converted to bicubic patches by the reader) and the mesh objects on
+    visible layers (drawn as meshes), by name; ``hidden``: kind -> count of objects on hidden layers; ``shape``: the
     OpenCASCADE shape of the whole file (STEP, IGES) for the baseline; ``baseline_faces``: filled by the baseline,
     the OpenCASCADE faces it meshed (for the deviation).
     """
@@ -86,6 +92,9 @@ class NurbsFile:
     other_kinds: tuple = ()
     shape: object = None
     baseline_faces: list = field(default_factory=list)
+    subd_names: tuple = ()
+    mesh_names: tuple = ()
+    hidden: dict = field(default_factory=dict)
 
 
 # ----------------------------------------------------------------------------------------------- counting
@@ -136,10 +145,23 @@ def _count_3dm(path: Path) -> dict | None:
     if f3 is None:
         return None
     names, not_nurbs, other = [], collections.Counter(), collections.Counter()
+    subd, meshes, hidden = [], [], collections.Counter()
+    visible_layers = {layer.Index for layer in f3.Layers if layer.Visible}
     for obj in f3.Objects:
         g = obj.Geometry
         kind = type(g).__name__
         name = obj.Attributes.Name or str(obj.Attributes.Id)
+        if isinstance(g, rhino3dm.SubD):
+            subd.append(name)
+            not_nurbs[kind] += 1
+            continue
+        if isinstance(g, rhino3dm.Mesh):
+            if obj.Attributes.Visible and obj.Attributes.LayerIndex in visible_layers:
+                meshes.append(name)
+            else:
+                hidden[kind] += 1
+            not_nurbs[kind] += 1
+            continue
         if isinstance(g, rhino3dm.Extrusion):
             brep = g.ToBrep(False)
             n = len(brep.Faces) if brep is not None else 1
@@ -153,7 +175,8 @@ def _count_3dm(path: Path) -> dict | None:
             continue
         names += [name] if n == 1 else [f"{name} face {k}" for k in range(n)]
     return {"faces": len(names), "tool": f"rhino3dm {getattr(rhino3dm, '__version__', '')}".strip(),
-            "names": names, "not_nurbs": dict(not_nurbs), "other": tuple(other)}
+            "names": names, "not_nurbs": dict(not_nurbs), "other": tuple(other), "subd": tuple(subd),
+            "meshes": tuple(meshes), "hidden": dict(hidden)}
 
 
 def _count_bpt(path: Path) -> dict | None:
@@ -193,7 +216,7 @@ def _read(path, options, findings) -> NurbsFile:
 
     path = Path(path)
     counted = count_faces(path)
-    if counted is not None and counted["faces"] == 0:
+    if counted is not None and counted["faces"] == 0 and not counted.get("subd"):
         extra = counted.get("not_nurbs") or {}
         why = (f"; it holds {_listing(extra)} object(s), which are not NURBS (convert them to NURBS in the CAD "
                "program, e.g. Rhino's ToNURBS)" if extra else "")
@@ -202,7 +225,8 @@ def _read(path, options, findings) -> NurbsFile:
     if counted is None:
         return NurbsFile(model, None, "not counted")
     return NurbsFile(model, counted["faces"], counted["tool"], counted.get("not_nurbs", {}), counted.get("names"),
-                     counted.get("other", ()), counted.get("shape"))
+                     counted.get("other", ()), counted.get("shape"), subd_names=counted.get("subd", ()),
+                     mesh_names=counted.get("meshes", ()), hidden=counted.get("hidden", {}))
 
 
 def _build(data: NurbsFile, options, findings) -> NurbsModel:
@@ -214,121 +238,6 @@ def _add(plotter, model, options):
 
 
 # ----------------------------------------------------------------------------------------------- baseline
-def _occ_arrays():
-    try:  # OCP 8: NCollection arrays in OCP.collections
-        from OCP.OCP.collections import Array1_double, Array1_gp_Pnt2d, Array1_int, Array2_double, Array2_gp_Pnt
-    except ImportError:  # OCP 7.x
-        from OCP.TColgp import TColgp_Array1OfPnt2d as Array1_gp_Pnt2d, TColgp_Array2OfPnt as Array2_gp_Pnt
-        from OCP.TColStd import TColStd_Array1OfInteger as Array1_int, TColStd_Array1OfReal as Array1_double
-        from OCP.TColStd import TColStd_Array2OfReal as Array2_double
-    return Array1_double, Array1_int, Array2_double, Array2_gp_Pnt, Array1_gp_Pnt2d
-
-
-def _knots(K):
-    Real1, Int1 = _occ_arrays()[:2]
-    values, mults = np.unique(np.asarray(K, dtype=np.float64), return_counts=True)
-    kv, km = Real1(1, len(values)), Int1(1, len(values))
-    for i, (a, m) in enumerate(zip(values, mults)):
-        kv.SetValue(i + 1, float(a))
-        km.SetValue(i + 1, int(m))
-    return kv, km
-
-
-def _occ_surface(s):
-    """A NurbsSurface as a ``Geom_BSplineSurface`` (same points, weights, knots: the same parametrization)."""
-    from OCP.Geom import Geom_BSplineSurface
-    from OCP.gp import gp_Pnt
-
-    _, _, Real2, Pnt2, _ = _occ_arrays()
-    nu, nv = s.shape
-    poles, weights = Pnt2(1, nu, 1, nv), Real2(1, nu, 1, nv)
-    w = np.ones((nu, nv)) if s.weights is None else s.weights
-    for i in range(nu):
-        for j in range(nv):
-            poles.SetValue(i + 1, j + 1, gp_Pnt(*map(float, s.control_points[i, j])))
-            weights.SetValue(i + 1, j + 1, float(w[i, j]))
-    (p, q), (U, V) = s.degree, s.knots
-    (ku, mu), (kv, mv) = _knots(U), _knots(V)
-    return Geom_BSplineSurface(poles, weights, ku, kv, mu, mv, p, q, False, False)
-
-
-def _occ_curve2d(c):
-    """A TrimCurve as a ``Geom2d_BSplineCurve``."""
-    from OCP.Geom2d import Geom2d_BSplineCurve
-    from OCP.gp import gp_Pnt2d
-
-    Real1, _, _, _, Pnt1 = _occ_arrays()
-    n = c.control_points.shape[0]
-    poles, weights = Pnt1(1, n), Real1(1, n)
-    w = np.ones(n) if c.weights is None else c.weights
-    for i in range(n):
-        poles.SetValue(i + 1, gp_Pnt2d(*map(float, c.control_points[i])))
-        weights.SetValue(i + 1, float(w[i]))
-    k, m = _knots(c.knots)
-    return Geom2d_BSplineCurve(poles, weights, k, m, c.degree, False)
-
-
-def _loop_area(loop) -> float:
-    """Area enclosed by a trim loop in (u, v) (shoelace over sampled points; its sign is the orientation)."""
-    pts = np.concatenate([c.evaluate(np.linspace(*c.domain, 33)) for c in loop])
-    x, y = pts[:, 0], pts[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-def _occ_face(s, loops, tol: float):
-    """One patch as an OpenCASCADE face: the surface bounded by its trim loops (the largest one the outer
-    boundary, the others holes, each oriented as OpenCASCADE wants), or its natural boundary."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
-    from OCP.BRepLib import BRepLib
-    from OCP.TopoDS import TopoDS
-
-    surf = _occ_surface(s)
-    if not loops:
-        return BRepBuilderAPI_MakeFace(surf, tol).Face()
-    wires = []
-    for loop in loops:
-        make = BRepBuilderAPI_MakeWire()
-        for c in loop:
-            make.Add(BRepBuilderAPI_MakeEdge(_occ_curve2d(c), surf).Edge())
-        wires.append((_loop_area(loop), make.Wire()))
-    wires.sort(key=lambda aw: -abs(aw[0]))
-    # OpenCASCADE keeps the material left of each wire in (u, v): the outer one counter-clockwise, holes clockwise
-    oriented = [w if (a > 0) == (k == 0) else TopoDS.Wire(w.Reversed()) for k, (a, w) in enumerate(wires)]
-    make = BRepBuilderAPI_MakeFace(surf, oriented[0], True)
-    for w in oriented[1:]:
-        make.Add(w)
-    face = make.Face()
-    BRepLib.BuildCurves3d_s(face)
-    return face
-
-
-def _model_shape(model: NurbsModel, tol: float):
-    """The model's patches as a compound of OpenCASCADE faces; ``(compound, [names it could not build])``."""
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-
-    builder, compound, failed = BRep_Builder(), TopoDS_Compound(), []
-    builder.MakeCompound(compound)
-    for s, loops in zip(model.surfaces, model.trims):
-        try:
-            builder.Add(compound, _occ_face(s, loops, tol))
-        except Exception as err:  # noqa: BLE001 -- OpenCASCADE refuses a face: the baseline lacks it, and says so
-            failed.append(f"{s.name} ({type(err).__name__})")
-    return compound, failed
-
-
-def _diagonal(shape) -> float:
-    from OCP.Bnd import Bnd_Box
-    from OCP.BRepBndLib import BRepBndLib
-
-    box = Bnd_Box()
-    BRepBndLib.Add_s(shape, box, False)
-    if box.IsVoid():
-        return 0.0
-    lo, hi = box.CornerMin(), box.CornerMax()
-    return float(np.linalg.norm([hi.X() - lo.X(), hi.Y() - lo.Y(), hi.Z() - lo.Z()]))
-
-
 def _baseline(data: NurbsFile, model, options, findings):
     """OpenCASCADE's mesh of the file's faces (module docstring) as a pyvista PolyData in world coordinates; point
     data ``uv`` (each node's surface parameters), cell data ``face_id``; field data ``deflection`` and
@@ -388,6 +297,12 @@ def _baseline(data: NurbsFile, model, options, findings):
         findings.append(Finding("WARN", f"baseline: OpenCASCADE did not mesh {unmeshed} face(s); the picture is "
                                         "compared without them"))
     data.baseline_faces = faces
+    for _, P, T in (model.companion_meshes() if model is not None else ()):  # the file's mesh objects, drawn as they are in both pictures
+        pts.append(P)
+        uvs.append(np.zeros((len(P), 2)))
+        tris.append(T + offset)
+        ids.append(np.full(len(T), -1))  # no surface: not part of the deviation
+        offset += len(P)
     mesh = pv.PolyData(np.concatenate(pts), faces=pv.CellArray.from_regular_cells(np.concatenate(tris)))
     mesh.point_data["uv"] = np.concatenate(uvs)
     mesh.cell_data["face_id"] = np.concatenate(ids)
@@ -418,7 +333,7 @@ def baseline_deviation(baseline, faces, delta: float) -> tuple:
     F = np.repeat(fid[sel], len(weights))
     dist = np.zeros(len(X))
     surfaces = {}
-    for k in np.unique(F):
+    for k in np.unique(F[F >= 0]):  # face_id -1: a mesh object of the file, no surface to compare with
         face, has_uv = faces[int(k)]
         if not has_uv:
             continue
@@ -427,6 +342,7 @@ def baseline_deviation(baseline, faces, delta: float) -> tuple:
         Y = np.array([S.Value(u, v).Coord() for u, v in W[idx].tolist()]).reshape(-1, 3)
         dist[idx] = np.linalg.norm(Y - X[idx], axis=1)
     worst = np.argsort(dist)[::-1][:MAX_PROJECTIONS]
+    worst = worst[F[worst] >= 0]
     for j in worst[dist[worst] > delta]:  # the interpolated (u, v) overestimates: project onto the surface
         proj = GeomAPI_ProjectPointOnSurf(gp_Pnt(*map(float, X[j])), surfaces[int(F[j])])
         if proj.NbPoints() > 0:
@@ -450,8 +366,61 @@ def _which(data: NurbsFile, model: NurbsModel) -> str:
     return "; ".join(parts) if parts else "the reader does not say which"
 
 
+def _from_subd(names, subd_names) -> np.ndarray:
+    """Which patch names come from a SubD object (``"<object> exact|approx <i>"``, :mod:`splinevis.io.subd`).
+
+    >>> _from_subd(["a face 0", "logo exact 3", "logo approx 0"], ["logo"]).tolist()
+    [False, True, True]
+    """
+    prefixes = tuple(f"{n} exact " for n in subd_names) + tuple(f"{n} approx " for n in subd_names)
+    return np.array([bool(prefixes) and n.startswith(prefixes) for n in names], dtype=bool)
+
+
+def _subd_findings(path, data: NurbsFile, model, diagonal, findings) -> dict:
+    """SubD objects: each converted to patches, and the patches' corners against Rhino's own limit points of the
+    control vertices (``SubDVertex.SurfacePoint``, openNURBS): a second reader of the same limit surface."""
+    import rhino3dm
+    from scipy.spatial import cKDTree
+
+    names = np.array(model.names, dtype=object)
+    mask = _from_subd(model.names, data.subd_names)
+    missing = [n for n in data.subd_names if not any(str(m).startswith((f"{n} exact ", f"{n} approx "))
+                                                     for m in names[mask])]
+    if missing:
+        findings.append(Finding("FAIL", f"{len(missing)} of the {len(data.subd_names)} SubD objects are not drawn: "
+                                        + ", ".join(repr(n) for n in missing[:MAX_LISTED])))
+    corners = []
+    for k in np.flatnonzero(mask):
+        s = model.surfaces[k]
+        (u0, u1), (v0, v1) = s.domain
+        corners.append(s.evaluate([u0, u1, u0, u1], [v0, v0, v1, v1]))
+    deviation, limit_points = None, 0
+    if corners:
+        tree = cKDTree(np.concatenate(corners))
+        f3 = rhino3dm.File3dm.Read(str(path))
+        L = np.array([[p.X, p.Y, p.Z] for obj in f3.Objects if isinstance(obj.Geometry, rhino3dm.SubD)
+                      for p in (v.SurfacePoint for v in _subd_vertices(obj.Geometry))]).reshape(-1, 3)
+        if len(L):
+            deviation, limit_points = float(tree.query(L)[0].max() / diagonal), len(L)
+    if not missing:
+        what = (f"all {len(data.subd_names)} SubD objects drawn as {int(mask.sum())} bicubic patches (Catmull-Clark "
+                f"limit surface)")
+        if deviation is not None:
+            what += f"; Rhino's limit points of the {limit_points} control vertices lie within {deviation:.1e} of " \
+                    "the diagonal of a patch corner"
+        findings.append(Finding("WARN" if deviation is not None and deviation > SUBD_WARN else "PASS", what))
+    return {"subd_objects": len(data.subd_names), "subd_patches": int(mask.sum()), "subd_limit_deviation": deviation}
+
+
+def _subd_vertices(subd) -> list:
+    """A rhino3dm SubD's vertices (its iterator's ``Next`` never returns None: walk ``Count`` of them)."""
+    it = subd.Vertices
+    return [it.First() if k == 0 else it.Next() for k in range(it.Count)]
+
+
 def _accuracy(path, data: NurbsFile, model, baseline, options, findings) -> dict:
-    drawn, in_file = len(model), data.faces_in_file
+    subd = _from_subd(model.names, data.subd_names)
+    drawn, in_file = int((~subd).sum()), data.faces_in_file
     delta = float(baseline.field_data["deflection"][0])
     diagonal = float(baseline.field_data["diagonal"][0])
     deviation, samples = baseline_deviation(baseline, data.baseline_faces, delta)
@@ -470,9 +439,15 @@ def _accuracy(path, data: NurbsFile, model, baseline, options, findings) -> dict
                                         f"(counted by {data.counted_by}): a face read twice, or split"))
     else:
         findings.append(Finding("PASS", f"all {in_file} faces in the file are drawn (counted by {data.counted_by})"))
-    if data.not_nurbs and in_file:
-        findings.append(Finding("WARN", f"the file also holds {_listing(data.not_nurbs)} object(s): not NURBS, not "
-                                        "drawn"))
+    if data.subd_names:
+        out.update(_subd_findings(path, data, model, diagonal, findings))
+    if data.mesh_names:
+        shown = len(model.companion_meshes())
+        out["mesh_objects"] = len(data.mesh_names)
+        findings.append(Finding("FAIL" if shown < len(data.mesh_names) else "PASS",
+                                f"{shown} of the {len(data.mesh_names)} mesh objects on visible layers drawn as meshes"))
+    if data.hidden:
+        findings.append(Finding("PASS", f"not drawn, hidden in the file (layer or object off): {_listing(data.hidden)}"))
     ratio = deviation / delta
     what = (f"baseline tessellation deviates up to {deviation / diagonal:.2e} of the diagonal from the exact "
             f"surfaces ({ratio:.2f} x the deflection {delta / diagonal:.0e} asked for; {samples} samples)")
@@ -491,59 +466,3 @@ JUDGE = FamilyJudge(
     read=_read, build=_build, baseline=_baseline, accuracy=_accuracy, add=_add,
     description="faces drawn against faces in the file (rhino3dm / OpenCASCADE), and OpenCASCADE's "
                 "BRepMesh at 1e-3 of the diagonal as the baseline, its deviation from the exact surfaces measured")
-
-
-# ------------------------------------------------------------------------- OpenCASCADE's orientation
-def occ_outward(model: NurbsModel, tol: float = 1e-6) -> np.ndarray:
-    """OpenCASCADE's answer: ``+1`` where a face's normal ``S_u x S_v`` points out of the solid its sewn shell
-    bounds, ``-1`` where it points in, ``0`` where the face is not in a closed shell (or not built).
-
-    Needs ``OCP`` (the ``cad`` extra). The faces are built as in the OpenCASCADE judge, sewn
-    (``BRepBuilderAPI_Sewing``), each shell oriented (``ShapeFix_Shell``) and made a solid with outward faces
-    (``ShapeFix_Solid``); a face REVERSED in that solid has its outside behind its surface normal. ``tol`` is
-    the absolute sewing tolerance (gaps of real files need about 1e-4 of the model's size); the independent
-    check of :func:`.orient.orient_faces`.
-
-    >>> from splinevis.nurbs.exact import box_faces
-    >>> from splinevis.nurbs.orient import flip_u
-    >>> faces = box_faces(2.0, 1.0, 1.0)
-    >>> occ_outward(NurbsModel(faces[:5] + [flip_u(faces[5])[0]]), 1e-7).tolist()  # the +x face turned in
-    [1.0, 1.0, 1.0, 1.0, 1.0, -1.0]
-    """
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
-    from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
-    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED, TopAbs_SHELL
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
-
-    faces = []
-    for s, loops in zip(model.surfaces, model.trims):
-        try:
-            faces.append(_occ_face(s, loops, tol))
-        except Exception:  # noqa: BLE001 -- a face OpenCASCADE cannot build has no answer (0)
-            faces.append(None)
-    sew = BRepBuilderAPI_Sewing(tol)
-    for f in faces:
-        if f is not None:
-            sew.Add(f)
-    sew.Perform()
-    sewn = sew.SewedShape()
-    out = np.zeros(len(faces))
-    images = [None if f is None else (sew.Modified(f) if sew.IsModified(f) else f) for f in faces]
-    shells = TopExp_Explorer(sewn, TopAbs_SHELL)
-    while shells.More():
-        fix = ShapeFix_Shell(TopoDS.Shell(shells.Current()))
-        fix.Perform()
-        shell = fix.Shell()
-        shells.Next()
-        if not shell.Closed():
-            continue
-        solid = ShapeFix_Solid().SolidFromShell(shell)
-        ex = TopExp_Explorer(solid, TopAbs_FACE)
-        while ex.More():
-            f = ex.Current()
-            ex.Next()
-            for k, img in enumerate(images):
-                if img is not None and img.IsSame(f):
-                    out[k] = -1.0 if f.Orientation() == TopAbs_REVERSED else 1.0
-    return out

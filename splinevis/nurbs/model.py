@@ -94,6 +94,9 @@ class NurbsModel:
         Findings about the model (e.g. ``report["orientation"]`` from
         :func:`splinevis.nurbs.orient.orient_faces`: faces flipped, shells closed, seams' continuity); empty
         by default.
+    meshes : sequence of (name, points (n, 3), triangles (m, 3))
+        Plain triangle meshes the file holds beside its surfaces (a CAD file's mesh objects), drawn as they are
+        next to the exact surfaces (:meth:`companion_meshes`); empty by default.
 
     Examples
     --------
@@ -110,6 +113,7 @@ class NurbsModel:
     source: str = ""
     skipped: dict = field(default_factory=dict)
     report: dict = field(default_factory=dict)
+    meshes: tuple = ()
 
     def __post_init__(self):
         surfaces = tuple(self.surfaces)
@@ -123,6 +127,27 @@ class NurbsModel:
             raise ValueError(f"trims must have one entry (None or loops) per surface: {len(trims)} for {len(surfaces)}.")
         object.__setattr__(self, "surfaces", surfaces)
         object.__setattr__(self, "trims", tuple(None if t is None else tuple(tuple(loop) for loop in t) for t in trims))
+        meshes = []
+        for k, (name, points, triangles) in enumerate(self.meshes):
+            P = np.asarray(points, dtype=np.float64)
+            T = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+            if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
+                raise ValueError(f"meshes[{k}] ({name!r}): points must be a finite (n, 3) array, got shape {P.shape}.")
+            if T.size and (T.min() < 0 or T.max() >= len(P)):
+                raise ValueError(f"meshes[{k}] ({name!r}): a triangle refers to point {int(T.max())} of {len(P)}.")
+            meshes.append((str(name), P, T))
+        object.__setattr__(self, "meshes", tuple(meshes))
+
+    def companion_meshes(self) -> tuple:
+        """The plain meshes drawn beside the surfaces: ``(name, points, triangles)`` each (the Plotter draws any
+        model's ``companion_meshes`` as ordinary meshes).
+
+        >>> from splinevis.nurbs.exact import saddle
+        >>> m = NurbsModel([saddle()], meshes=[("tri", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])])
+        >>> [(n, P.shape, T.tolist()) for n, P, T in m.companion_meshes()]
+        [('tri', (3, 3), [[0, 1, 2]])]
+        """
+        return self.meshes
 
     def __len__(self) -> int:
         return len(self.surfaces)

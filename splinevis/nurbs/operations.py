@@ -189,7 +189,7 @@ def refine_knots(surface: NurbsSurface, direction, knots) -> NurbsSurface:
 
 
 def elevate_degree(surface: NurbsSurface, direction, times: int = 1) -> NurbsSurface:
-    """Raise the degree in one direction by ``times`` (up to 7), keeping the surface and its continuity
+    """Raise the degree in one direction by ``times`` (up to ``basis.MAX_DEGREE``), keeping the surface and its continuity
     (every distinct knot gains one multiplicity per step) [PieglTiller1997, A5.9, A5.10].
 
     An unclamped knot vector is clamped at the domain ends first.

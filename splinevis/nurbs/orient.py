@@ -45,7 +45,7 @@ Newton steps along that curve from the polyline's foot), the kink angle between 
 seam (:func:`.continuity.normal_curvature`); the class is :func:`.continuity.classify` (``open``: a gap above
 ``tol_gap``). Samples where the other edge has already ended (a T-junction) are left out.
 
-When OpenCASCADE (``OCP``, the ``cad`` extra) is installed, :func:`.judge.occ_outward` orients the same faces by
+When OpenCASCADE (``OCP``, the ``cad`` extra) is installed, :func:`.occ_faces.occ_outward` orients the same faces by
 sewing them and fixing the shell (``BRepBuilderAPI_Sewing``, ``ShapeFix_Shell``, ``ShapeFix_Solid``): an
 independent check of this module (the tests compare both).
 """

@@ -32,6 +32,8 @@ from .surface import NurbsSurface
 __all__ = ["nurbs_tables", "nurbs_program", "model_from", "PROGRAM"]
 
 _SPLIT = 4096
+#: SV_NURBS_MAX_DEGREE of lib/nurbs/basis.glsl when the program does not define it.
+_GLSL_DEGREE = 7
 
 
 def nurbs_tables(model: NurbsModel) -> dict:
@@ -92,6 +94,11 @@ def nurbs_program(model, style=None, *, newton_iterations: int = 12, subdivision
     zr = np.asarray(model.bounds()[4:]) - model_offset(model)[2]
     trim = _trim_spec(model)
     defines = dict(trim.get("defines", {}))
+    degree = max(max(s.degree) for s in model.surfaces)
+    if degree > _GLSL_DEGREE:
+        # the shader's local basis arrays are sized by SV_NURBS_MAX_DEGREE (lib/nurbs/basis.glsl, 7 by default):
+        # raised only for a model that needs it, so the common low-degree program keeps its cost
+        defines["SV_NURBS_MAX_DEGREE"] = int(degree)
     if any(t is not None for f in patch_facts(model) for t in f["pole_tables"]):
         # the antipode rule over asymmetric poles (lib/nurbs/poles.glsl) is compiled in only for models that have
         # one: inside the Newton loop it doubles llvmpipe's time per fragment even where it never runs

@@ -11,10 +11,15 @@
 //                     its pole tables (lower edge first).
 //   sv_nurbs_cps    : homogeneous control points (w (P - offset), w), one texel each, P[k, l] at k * nv + l.
 // Loops run to the constant SV_NURBS_MAX_DEGREE and leave early at the patch's degree (no switch per degree).
+// SV_NURBS_MAX_DEGREE is 7 unless the program defines it higher (splinevis/nurbs/program.py: the model's
+// largest degree when above 7, up to splinevis.nurbs.basis.MAX_DEGREE): the local arrays are sized by it,
+// so models of degree <= 7 keep the arrays (and registers) of the degree-7 program.
 #include "lib/core/table.glsl"
 
+#ifndef SV_NURBS_MAX_DEGREE
 #define SV_NURBS_MAX_DEGREE 7
-#define SV_NURBS_ORDER 8   // SV_NURBS_MAX_DEGREE + 1, the row length of the flattened triangular tables
+#endif
+#define SV_NURBS_ORDER (SV_NURBS_MAX_DEGREE + 1)   // the row length of the flattened triangular tables
 
 // (the samplers sv_nurbs_header, sv_nurbs_knots, sv_nurbs_cps are declared by VTK for the actor's textures)
 
