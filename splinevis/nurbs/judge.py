@@ -382,6 +382,8 @@ def _subd_findings(path, data: NurbsFile, model, diagonal, findings) -> dict:
     import rhino3dm
     from scipy.spatial import cKDTree
 
+    from ..io.subd import _rhino_items  # the one walk over a rhino3dm SubD iterator
+
     names = np.array(model.names, dtype=object)
     mask = _from_subd(model.names, data.subd_names)
     missing = [n for n in data.subd_names if not any(str(m).startswith((f"{n} exact ", f"{n} approx "))
@@ -399,7 +401,7 @@ def _subd_findings(path, data: NurbsFile, model, diagonal, findings) -> dict:
         tree = cKDTree(np.concatenate(corners))
         f3 = rhino3dm.File3dm.Read(str(path))
         L = np.array([[p.X, p.Y, p.Z] for obj in f3.Objects if isinstance(obj.Geometry, rhino3dm.SubD)
-                      for p in (v.SurfacePoint for v in _subd_vertices(obj.Geometry))]).reshape(-1, 3)
+                      for p in (v.SurfacePoint for v in _rhino_items(obj.Geometry.Vertices))]).reshape(-1, 3)
         if len(L):
             deviation, limit_points = float(tree.query(L)[0].max() / diagonal), len(L)
     if not missing:
@@ -410,12 +412,6 @@ def _subd_findings(path, data: NurbsFile, model, diagonal, findings) -> dict:
                     "the diagonal of a patch corner"
         findings.append(Finding("WARN" if deviation is not None and deviation > SUBD_WARN else "PASS", what))
     return {"subd_objects": len(data.subd_names), "subd_patches": int(mask.sum()), "subd_limit_deviation": deviation}
-
-
-def _subd_vertices(subd) -> list:
-    """A rhino3dm SubD's vertices (its iterator's ``Next`` never returns None: walk ``Count`` of them)."""
-    it = subd.Vertices
-    return [it.First() if k == 0 else it.Next() for k in range(it.Count)]
 
 
 def _accuracy(path, data: NurbsFile, model, baseline, options, findings) -> dict:
