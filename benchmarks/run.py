@@ -22,6 +22,8 @@ Cases
   the same triangles, full-screen C1 terrain, one run (``bench_mesh_guided.py``).
 * ``outofcore``: terrain and volume splines built tile by tile on dask and written to zarr
   (``bench_outofcore.py``): wall time, tiles/s at 1 and 2 workers, disk and peak memory of a fresh process.
+* ``nurbs_files``: many-face CAD models (real STEP/IGES files when ``../shared/data/nurbs`` is there, synthetic
+  ones always) from the file to the first frame, stage by stage, in fresh processes (``bench_nurbs_files.py``).
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -251,6 +253,10 @@ def _markdown(results):
         from bench_outofcore import outofcore_markdown
 
         lines.append(outofcore_markdown(results["outofcore"]))
+    if "nurbs_files" in results:
+        from bench_nurbs_files import nurbs_files_markdown
+
+        lines.append(nurbs_files_markdown(results["nurbs_files"]))
     return "\n".join(lines) + "\n"
 
 
@@ -269,13 +275,15 @@ def main(argv=None):
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
     from bench_mesh_guided import bench_mesh_guided
+    from bench_nurbs_files import bench_nurbs_files
     from bench_outofcore import bench_outofcore
     from bench_profile import bench_profile
     from bench_scale import bench_cold_start, bench_large_terrain
 
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
              ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
-             ("profile", bench_profile), ("mesh_guided", bench_mesh_guided), ("outofcore", bench_outofcore)]
+             ("profile", bench_profile), ("mesh_guided", bench_mesh_guided), ("outofcore", bench_outofcore),
+             ("nurbs_files", bench_nurbs_files)]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

@@ -56,7 +56,7 @@ def test_the_plain_formula_leaves_the_domain_and_at_fraction_does_not():
 @pytest.mark.parametrize("domain", REAL_DOMAINS, ids=lambda d: f"[{d[0]!r}, {d[1]!r}]")
 def test_every_path_from_a_domain_to_parameters_stays_inside(domain):
     """Failed before the helper with "parameter ... is outside the knot domain" (the Rhino and STEP domains)."""
-    from splinevis.nurbs import continuity, raycast, tessellate
+    from splinevis.nurbs import continuity, raycast, shell, tessellate
     from splinevis.nurbs.pullback import _Inverter
 
     s = _surface(domain, domain)
@@ -66,10 +66,10 @@ def test_every_path_from_a_domain_to_parameters_stays_inside(domain):
     us, vs = tessellate.span_grid(s, 4)
     assert us[0] == domain[0] and us[-1] == domain[1] and (np.diff(us) >= 0).all()
     assert vs[0] == domain[0] and vs[-1] == domain[1] and (np.diff(vs) >= 0).all()
-    bound = raycast.certified_deviation(s, us, vs)
+    bound = shell.certified_deviation(s, us, vs)
     assert np.isfinite(bound).all() and (bound >= 0).all()
-    assert raycast._closed(s, 0) in (True, False) and raycast._closed(s, 1) in (True, False)
-    proxy = raycast.tessellate(model, subdivisions=2)
+    assert shell._closed(s, 0) in (True, False) and shell._closed(s, 1) in (True, False)
+    proxy = shell.tessellate(model, subdivisions=2)
     assert proxy is not None
     assert continuity.find_seams([s]) is not None
     foot = _Inverter(s)

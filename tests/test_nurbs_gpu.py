@@ -108,12 +108,12 @@ def test_a_single_surface_is_drawn_as_a_one_patch_model():
 
 
 def test_the_certified_shell_push_is_at_least_the_densely_sampled_chord_deviation():
-    # the shell's push is the Bernstein bound of S - L over each cell (raycast.certified_deviation): it must
+    # the shell's push is the Bernstein bound of S - L over each cell (shell.certified_deviation): it must
     # exceed the deviation sampled at 32 x 32 points on every cell of the test models (a bound can't be beaten
     # by a sample); and it stays within 10x of it (not uselessly loose)
     from datasets_synthetic.nurbs_models import degree_patch, hood, vase
     from splinevis.nurbs.hard_cases import crease, degree7
-    from splinevis.nurbs.raycast import _chord_deviation, certified_deviation
+    from splinevis.nurbs.shell import _chord_deviation, certified_deviation
     from splinevis.nurbs.tessellate import span_grid
 
     models = [sphere(), torus(), crease(), degree7(), hood(), degree_patch(5)] + list(vase().surfaces[:8])

@@ -26,7 +26,8 @@ from ..gl.contract import SplineProgram
 from ..gl.proxies import pack_rgba32f
 from ..gl.spec import ProgramSpec
 from .model import NurbsModel
-from .raycast import depth_bound, model_offset, patch_facts, reference, tessellate
+from .raycast import depth_bound, reference
+from .shell import model_offset, patch_facts, tessellate
 from .surface import NurbsSurface
 
 __all__ = ["nurbs_tables", "nurbs_program", "model_from", "PROGRAM"]
@@ -77,7 +78,8 @@ def nurbs_program(model, style=None, *, newton_iterations: int = 12, subdivision
         Largest number of Newton steps on the pixel ray per fragment (a fragment stops one step after its
         residual is accepted; 12: grazing rays near silhouettes converge only linearly).
     subdivisions : int
-        Tessellation cells per knot span and direction (:func:`splinevis.nurbs.raycast.tessellate`).
+        Tessellation cells per knot span and direction for a span that turns 90 degrees, fewer for flatter
+        spans (:func:`splinevis.nurbs.shell.shell_grid`).
 
     >>> from splinevis.nurbs.exact import torus
     >>> spec = nurbs_program(torus(), subdivisions=2)
@@ -90,7 +92,7 @@ def nurbs_program(model, style=None, *, newton_iterations: int = 12, subdivision
     if int(subdivisions) < 1:
         raise ValueError(f"subdivisions must be >= 1, got {subdivisions!r}.")
     t = nurbs_tables(model)
-    points, triangles, uv, patch = tessellate(model, int(subdivisions))
+    points, triangles, uv, patch = tessellate(model, int(subdivisions), adaptive=True)
     zr = np.asarray(model.bounds()[4:]) - model_offset(model)[2]
     trim = _trim_spec(model)
     defines = dict(trim.get("defines", {}))

@@ -3,8 +3,7 @@
 The GPU rasterizes a coarse tessellation whose vertices carry ``(u, v)`` and a patch id, and refines the
 interpolated parameters by Newton on the pixel's ray written as two planes [Kanai2007, sec. 3.1]. Here:
 
-* :func:`tessellate`: that tessellation (shared with ``program.py``), a shell of two layers pushed along the
-  normal by a bound of the chord deviation, open edges pushed outward in the tangent plane;
+* the tessellation itself (shared with ``program.py``) is :func:`splinevis.nurbs.shell.tessellate`;
 * :func:`newton_on_rays`: the same clamped/wrapped Newton, vectorized, in float64;
 * :func:`reference`: the robust ray cast: every crossing of the ray with a finer shell gives a start, Newton
   in float64 to convergence, the nearest converged root in the domain wins;
@@ -17,214 +16,11 @@ import numpy as np
 
 from ..gl.contract import RayHits
 from ..gl.error_bounds import U32, depth_error, model_frame_matrix
-from .basis import at_fraction, into_domain
-from .model import NurbsModel
-from .poles import cross_pole, pole_tables
-from .surface import NurbsSurface
-from .tessellate import span_grid
+from .basis import into_domain
+from .poles import cross_pole
+from .shell import _as_model, model_offset, patch_facts, tessellate
 
-__all__ = ["model_offset", "patch_facts", "tessellate", "newton_on_rays", "reference", "residual_tolerance",
-           "depth_bound"]
-
-
-def _as_model(model) -> NurbsModel:
-    return NurbsModel([model]) if isinstance(model, NurbsSurface) else model
-
-
-def model_offset(model) -> np.ndarray:
-    """World position of the model frame's origin: the centre of the control points' box.
-
-    >>> from splinevis.nurbs.exact import sphere
-    >>> model_offset(NurbsModel([sphere(1.0, (1e6, 0, 0))])).tolist()
-    [1000000.0, 0.0, 0.0]
-    """
-    b = np.asarray(_as_model(model).bounds()).reshape(3, 2)
-    return 0.5 * (b[:, 0] + b[:, 1])
-
-
-def _closed(s: NurbsSurface, axis: int) -> bool:
-    (u0, u1), (v0, v1) = s.domain
-    t = np.linspace(0.0, 1.0, 7)
-    if axis == 0:
-        a, b = s.evaluate(np.full(7, u0), at_fraction(v0, v1, t)), s.evaluate(np.full(7, u1), at_fraction(v0, v1, t))
-    else:
-        a, b = s.evaluate(at_fraction(u0, u1, t), np.full(7, v0)), s.evaluate(at_fraction(u0, u1, t), np.full(7, v1))
-    scale = np.abs(s.control_points).max() + np.ptp(s.control_points.reshape(-1, 3), axis=0).max()
-    return bool(np.abs(a - b).max() <= 1e-12 * scale)
-
-
-def _poles(s: NurbsSurface) -> tuple:
-    """Collapsed edges (u=lo, u=hi, v=lo, v=hi): edges whose control points coincide (a pole of a revolved
-    surface)."""
-    P = s.control_points
-    scale = 1e-12 * (1 + np.abs(P).max())
-    return tuple(bool(np.ptp(e, axis=0).max() <= scale) for e in (P[0], P[-1], P[:, 0], P[:, -1]))
-
-
-def patch_facts(model) -> list:
-    """Per patch: dict with ``closed`` (u, v), ``magnitude`` M = max |P - offset| * max w / min w (model frame)
-    and ``knot_max`` = largest |knot|: what the float32 tolerances of the shader are built from; ``poles``: which
-    edges (u=lo, u=hi, v=lo, v=hi) collapse to a point; ``pole_tables``: per edge, the antipode table of a pole
-    without half-turn symmetry (:func:`splinevis.nurbs.poles.pole_tables`) or None.
-
-    >>> from splinevis.nurbs.exact import sphere
-    >>> f = patch_facts(NurbsModel([sphere()]))[0]
-    >>> f["closed"], round(f["magnitude"], 6), f["knot_max"]
-    ((True, False), 3.464102, 1.0)
-    """
-    m = _as_model(model)
-    off = model_offset(m)
-    out = []
-    for s in m.surfaces:
-        w = np.ones(s.shape) if s.weights is None else s.weights
-        mag = float(np.linalg.norm(s.control_points - off, axis=-1).max() * w.max() / w.min())
-        kmax = float(max(np.abs(s.knots[0]).max(), np.abs(s.knots[1]).max()))
-        closed, poles = (_closed(s, 0), _closed(s, 1)), _poles(s)
-        out.append({"closed": closed, "magnitude": mag, "knot_max": kmax, "poles": poles,
-                    "pole_tables": pole_tables(s, closed, poles)})
-    return out
-
-
-def tessellate(model, subdivisions: int = 4, margin: float = 2.0, certified: bool = True):
-    """The shell the GPU rasterizes: per patch, each non-empty knot span cut into ``subdivisions`` parts in u
-    and v; every grid vertex carries its ``(u, v)`` and patch id.
-
-    The chord deviation of each cell's two triangles is bounded by :func:`certified_deviation` (Bernstein
-    coefficients of ``A - w L`` over the cell: an upper bound, not a sample); ``certified=False`` samples it
-    instead (an 8 x 8 grid of the cell's parameters) times ``margin``. Two layers, at +dev and -dev along the unit
-    normal, enclose the surface; vertices on an open patch edge also move by dev outward in the tangent plane
-    (so the boundary curve's own chord deviation is covered).
-
-    Returns ``points (N, 3)`` (model frame), ``triangles (M, 3)``, ``uv (N, 2)``, ``patch (N,)``.
-
-    >>> from splinevis.nurbs.exact import saddle
-    >>> pts, tris, uv, patch = tessellate(NurbsModel([saddle()]), 2)
-    >>> pts.shape, tris.shape, sorted(set(patch.tolist()))
-    ((18, 3), (16, 3), [0.0])
-    """
-    m = _as_model(model)
-    off = model_offset(m)
-    facts = patch_facts(m)
-    P, T, UV, ID = [], [], [], []
-    base = 0
-    for k, s in enumerate(m.surfaces):
-        us, vs = span_grid(s, subdivisions)
-        dev = certified_deviation(s, us, vs) if certified else _chord_deviation(s, us, vs, margin)
-        hu, hv = np.diff(us), np.diff(vs)
-        floor = 64 * U32 * facts[k]["magnitude"]
-        vdev = np.full((len(us), len(vs)), floor)
-        for di in (0, 1):
-            for dj in (0, 1):
-                vdev[di: di + len(hu), dj: dj + len(hv)] = np.maximum(vdev[di: di + len(hu), dj: dj + len(hv)], dev + floor)
-        gu, gv = np.meshgrid(us, vs, indexing="ij")
-        uu, vv = gu.ravel(), gv.ravel()
-        d1 = s.derivatives(uu, vv, 1)
-        S = d1[:, 0, 0] - off
-        n = s.normal(uu, vv)
-        n = np.where(np.isfinite(n), n, 0.0)
-        push = vdev.ravel()[:, None]
-        side = np.zeros_like(S)
-        closed_u, closed_v = facts[k]["closed"]
-        for axis, closed, at in ((0, closed_u, uu), (1, closed_v, vv)):
-            if closed:
-                continue
-            tang = d1[:, 1, 0] if axis == 0 else d1[:, 0, 1]
-            size = np.linalg.norm(tang, axis=-1, keepdims=True)
-            unit = np.divide(tang, size, out=np.zeros_like(tang), where=size > 0)
-            lo, hi = s.domain[axis]
-            for end, sign in ((lo, -1.0), (hi, 1.0)):
-                on = at == end
-                if np.ptp(S[on], axis=0).max() <= 1e-12 * (1 + np.abs(S).max()):
-                    continue  # a collapsed edge (a pole): a point, not a boundary
-                side += sign * np.where(on[:, None], unit, 0.0)
-        nverts = len(uu)
-        for sign in (1.0, -1.0):
-            P.append(S + sign * push * n + push * side)
-            UV.append(np.column_stack([uu, vv]))
-            ID.append(np.full(nverts, float(k)))
-            idx = base + np.arange(nverts).reshape(len(us), len(vs))
-            a, b, c, e = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-            T.append(np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, e])]))
-            base += nverts
-    return np.concatenate(P), np.concatenate(T), np.concatenate(UV), np.concatenate(ID)
-
-
-def _bernstein_collocation(n: int) -> np.ndarray:
-    """Inverse of the (n+1) x (n+1) matrix of the degree-n Bernstein polynomials at the nodes k / n."""
-    from math import comb
-
-    x = np.arange(n + 1) / n
-    M = np.array([[comb(n, j) * xi**j * (1 - xi) ** (n - j) for j in range(n + 1)] for xi in x])
-    return np.linalg.inv(M)
-
-
-def certified_deviation(s, us, vs) -> np.ndarray:
-    """Per cell ``[us[i], us[i+1]] x [vs[j], vs[j+1]]``: an upper bound on the distance between the surface and
-    the two triangles (diagonal from (u0, v0) to (u1, v1)) that interpolate its corners.
-
-    On a cell (inside one knot span) the homogeneous surface ``(A, w)`` is a polynomial of bidegree (p, q); for
-    a triangle's linear interpolant L, ``S - L = (A - w L) / w`` with ``A - w L`` of bidegree (p + 1, q + 1).
-    Its Bernstein coefficients on the cell (from values at (p + 2) x (q + 2) nodes) bound it (convex hull:
-    ``|A - w L| <= max |d_ij|``), and ``w >= min`` of w's coefficients at the same bidegree, positive for
-    positive weights. So ``|S - L| <= max |d_ij| / min w_ij`` on the whole cell, a fortiori on the triangle;
-    the collocation's rounding (condition ~1e3 for bidegree 8) is covered by a relative 1e-12 of the
-    coordinates.
-
-    >>> from splinevis.nurbs.exact import cylinder
-    >>> s = cylinder(1.0)
-    >>> us, vs = np.linspace(0, 1, 17), np.array([0.0, 1.0])
-    >>> b = certified_deviation(s, us, vs)
-    >>> bool((b >= _chord_deviation(s, us, vs, 1.0, k=32)).all()), round(float(b.max()), 4)
-    (True, 0.0286)
-    """
-    (p, q) = s.degree
-    gu, gv = _bernstein_collocation(p + 1), _bernstein_collocation(q + 1)
-    fu, fv = np.arange(p + 2) / (p + 1), np.arange(q + 2) / (q + 1)
-    nu, nv = len(us) - 1, len(vs) - 1
-    uu = at_fraction(us[:-1, None], us[1:, None], fu[None, :])  # (nu, p+2), each node inside its cell
-    vv = at_fraction(vs[:-1, None], vs[1:, None], fv[None, :])  # (nv, q+2)
-    # keep each node inside its own cell's knot span (the right end of a span belongs to the next one)
-    U, V = s.knots
-    uu[:, -1] = np.nextafter(uu[:, -1], uu[:, 0])
-    vv[:, -1] = np.nextafter(vv[:, -1], vv[:, 0])
-    UU = np.broadcast_to(uu[:, None, :, None], (nu, nv, p + 2, q + 2)).ravel()
-    VV = np.broadcast_to(vv[None, :, None, :], (nu, nv, p + 2, q + 2)).ravel()
-    Aw = s._homogeneous_derivatives(UU, VV, 0)[:, 0, 0].reshape(nu, nv, p + 2, q + 2, 4)
-    A, w = Aw[..., :3], Aw[..., 3]
-    S = A / w[..., None]
-    c00, c10, c01, c11 = S[:, :, 0, 0], S[:, :, -1, 0], S[:, :, 0, -1], S[:, :, -1, -1]
-    a, b = fu[:, None, None], fv[None, :, None]  # node coordinates in the cell
-    lower = c00[:, :, None, None] + a * (c10 - c00)[:, :, None, None] + b * (c11 - c10)[:, :, None, None]
-    upper = c00[:, :, None, None] + a * (c11 - c01)[:, :, None, None] + b * (c01 - c00)[:, :, None, None]
-    wc = np.einsum("ik,jl,xykl->xyij", gu, gv, w)  # Bernstein coefficients of w at bidegree (p+1, q+1)
-    wmin = wc.min(axis=(2, 3))
-    if (wmin <= 0).any():
-        raise ValueError(f"{s.name or 'patch'}: a cell's weights are not all positive; cannot bound its chord.")
-    bound = np.zeros((nu, nv))
-    for L in (lower, upper):
-        d = np.einsum("ik,jl,xyklc->xyijc", gu, gv, A - w[..., None] * L)
-        bound = np.maximum(bound, np.linalg.norm(d, axis=-1).max(axis=(2, 3)) / wmin)
-    size = np.abs(S).max(axis=(2, 3, 4))
-    return bound + 1e-12 * size
-
-
-def _chord_deviation(s, us, vs, margin, k=8):
-    """Per cell: ``margin`` times the largest distance, over a k x k sample of the cell, between the surface and
-    the two triangles (diagonal from (u0, v0) to (u1, v1)) that interpolate its corners."""
-    f = np.arange(k + 1) / k
-    uf = np.append((us[:-1, None] + f[:-1] * np.diff(us)[:, None]).ravel(), us[-1])
-    vf = np.append((vs[:-1, None] + f[:-1] * np.diff(vs)[:, None]).ravel(), vs[-1])
-    gu, gv = np.meshgrid(uf, vf, indexing="ij")
-    S = s.evaluate(gu.ravel(), gv.ravel()).reshape(len(uf), len(vf), 3)
-    nu, nv = len(us) - 1, len(vs) - 1
-    cells = np.lib.stride_tricks.sliding_window_view(S, (k + 1, k + 1), axis=(0, 1))[::k, ::k]  # (nu, nv, 3, k+1, k+1)
-    cells = np.moveaxis(cells, 2, -1)
-    p00, p10, p01, p11 = cells[:, :, :1, :1], cells[:, :, -1:, :1], cells[:, :, :1, -1:], cells[:, :, -1:, -1:]
-    a, b = f[:, None, None], f[None, :, None]
-    lower = p00 + a * (p10 - p00) + b * (p11 - p10)  # a >= b: triangle (00, 10, 11)
-    upper = p00 + a * (p11 - p01) + b * (p01 - p00)  # a < b: triangle (00, 11, 01)
-    lin = np.where(a >= b, lower, upper)
-    return margin * np.linalg.norm(cells - lin, axis=-1).reshape(nu, nv, -1).max(axis=-1)
+__all__ = ["newton_on_rays", "reference", "residual_tolerance", "depth_bound"]
 
 
 #: Fraction of the way to an open edge a Newton step that would leave the domain goes (never onto the edge:
@@ -410,7 +206,8 @@ def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
     off = model_offset(m)
     o = np.asarray(origins, dtype=np.float64).reshape(-1, 3) - off
     d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
-    shells = [tessellate(m, sub) for sub in ((subdivisions,) if gpu else (4, subdivisions))]
+    # the GPU's own shell (adaptive) for its twin; the reference starts from the uniform 4 and 8 per span
+    shells = [tessellate(m, sub, adaptive=gpu) for sub in ((subdivisions,) if gpu else (4, subdivisions))]
     pts = np.concatenate([sh[0] for sh in shells])
     shift = np.cumsum([0] + [len(sh[0]) for sh in shells[:-1]])
     tris = np.concatenate([sh[1] + k for sh, k in zip(shells, shift)])

@@ -181,7 +181,11 @@ class NurbsSurface:
         array([[0., 0., 1.]])
         """
         u, v = self._params(u, v)
-        n, degenerate = _unit_normal(self.derivatives(u, v, 2), with_mask=True)
+        return self._normal(u, v, self.derivatives(u, v, 2))
+
+    def _normal(self, u, v, SKL) -> np.ndarray:
+        """:meth:`normal` from the derivatives ``SKL`` (order 2) at ``(u, v)`` already evaluated."""
+        n, degenerate = _unit_normal(SKL, with_mask=True)
         if degenerate.any():  # orient the limit normal like the regular normal just inside the domain
             (u0, u1), (v0, v1) = self.domain
             h = 1e-7

@@ -15,6 +15,7 @@ zoom: no polygon, no staircase.
 
 from __future__ import annotations
 
+from functools import cache
 from math import comb
 
 import numpy as np
@@ -77,18 +78,56 @@ def _split(seg, t):
 
 
 def _v_turns(seg) -> list:
-    """Parameters in (0, 1) where v(t) = Y/W turns: real roots of Y' W - Y W' (power basis)."""
+    """Parameters in (0, 1) where v(t) = Y/W turns: real roots of Y' W - Y W' (power basis).
+
+    The same arithmetic as ``numpy.polynomial.polynomial`` (polyder, polymul, polysub, polyroots: the same
+    products, convolutions and trimmed trailing zeros, so the same bits) without its per-call checks; a line
+    (degree 1) has the constant numerator ``y1 w0 - y0 w1`` (its t coefficient is ``Y_1 W_1 - Y_1 W_1 = 0``
+    exactly) and never turns.
+
+    >>> _v_turns(np.array([[0.0, 0.0, 1.0], [0.5, 1.0, 1.0], [1.0, 0.0, 1.0]]))  # a parabola's apex
+    [0.5]
+    """
     p = len(seg) - 1
-    M = np.array([[comb(p, i) * comb(p - i, k - i) * (-1) ** (k - i) if k >= i else 0 for i in range(p + 1)]
-                  for k in range(p + 1)], dtype=np.float64)  # power coefficients a_k of t^k from Bernstein
+    if p <= 1:
+        return []
+    M = _power_matrix(p)
     Y, W = M @ seg[:, 1], M @ seg[:, 2]
-    Pn = np.polynomial.polynomial
-    num = Pn.polysub(Pn.polymul(Pn.polyder(Y), W), Pn.polymul(Y, Pn.polyder(W)))
-    num = np.trim_zeros(num, "b")
+    dY, dW = Y[1:] * np.arange(1, p + 1), W[1:] * np.arange(1, p + 1)  # polyder: j * c[j]
+    a = _trimseq(np.convolve(_trimseq(dY), _trimseq(W)))  # polymul trims its inputs and its result
+    b = _trimseq(np.convolve(_trimseq(Y), _trimseq(dW)))
+    if len(a) > len(b):  # polysub
+        num = a.copy()
+        num[: b.size] -= b
+    else:
+        num = -b
+        num[: a.size] += a
+    num = _trimseq(num)
+    num = num[: np.flatnonzero(num)[-1] + 1] if num.any() else num[:0]  # np.trim_zeros(num, "b")
     if num.size <= 1:
         return []
     roots = Pn.polyroots(num)
     return sorted(float(r.real) for r in roots if abs(r.imag) < 1e-12 and 1e-12 < r.real < 1 - 1e-12)
+
+
+Pn = np.polynomial.polynomial
+
+
+def _trimseq(c):
+    """numpy.polynomial.polyutils.trimseq: trailing zeros dropped, at least one coefficient kept."""
+    i = len(c)
+    while i > 1 and c[i - 1] == 0:
+        i -= 1
+    return c[:i]
+
+
+@cache
+def _power_matrix(p: int) -> np.ndarray:
+    """Power coefficients a_k of t^k from Bernstein coefficients of degree p (row k)."""
+    M = np.array([[comb(p, i) * comb(p - i, k - i) * (-1) ** (k - i) if k >= i else 0 for i in range(p + 1)]
+                  for k in range(p + 1)], dtype=np.float64)
+    M.setflags(write=False)
+    return M
 
 
 def trim_pieces(trims) -> TrimPieces:
@@ -146,6 +185,27 @@ def _eval(ctrl, deg, t):
     return out[:, :2] / out[:, 2:3]
 
 
+def _evaluator(ctrl, deg):
+    """``f(t, axis)``: coordinate ``axis`` of :func:`_eval` ``(ctrl, deg, t)`` (the same arithmetic, the same
+    bits), with the pieces grouped by degree once."""
+    groups = []
+    for p in np.unique(deg):
+        sel = np.flatnonzero(deg == p)
+        groups.append((int(p), sel, ctrl[sel, : p + 1]))
+
+    def f(t, axis):
+        out = np.empty((len(t), 3))
+        for p, sel, c in groups:
+            q = c
+            tt = t[sel][:, None]
+            for r in range(p):
+                q = (1 - tt[:, None]) * q[:, :-1] + tt[:, None] * q[:, 1:]
+            out[sel] = q[:, 0]
+        return out[:, axis] / out[:, 2]
+
+    return f
+
+
 def inside(pieces: TrimPieces, patch: int, u, v, iterations: int = 60) -> np.ndarray:
     """Even-odd inside test of parameters ``(u, v)`` of patch ``patch`` (True everywhere for an untrimmed patch).
 
@@ -177,11 +237,12 @@ def inside(pieces: TrimPieces, patch: int, u, v, iterations: int = 60) -> np.nda
     if pi.size:
         up = last[pk] > first[pk]
         a, b = np.zeros(pi.size), np.ones(pi.size)
+        evaluate = _evaluator(ctrl[pk], deg[pk])  # the pieces sorted by degree once, not at every step
         for _ in range(iterations):  # bisection on the monotone v(t) = v0
             m = 0.5 * (a + b)
-            vm = _eval(ctrl[pk], deg[pk], m)[:, 1]
+            vm = evaluate(m, 1)
             below = (vm < v[pi]) == up
             a, b = np.where(below, m, a), np.where(below, b, m)
-        um = _eval(ctrl[pk], deg[pk], 0.5 * (a + b))[:, 0]
+        um = evaluate(0.5 * (a + b), 0)
         np.add.at(crossings, pi, (um > u[pi]).astype(int))
     return crossings % 2 == 1

@@ -1,0 +1,142 @@
+"""The GPU shell of the NURBS program (splinevis/nurbs/shell.py) and the build's fast paths: straight directions
+get one cell per knot span (span_turning bounds the tangents' turn), curved ones keep all their cells; the cached
+patch facts, the lean trim-piece cuts and the grouped trim evaluation give the same bits as the plain code."""
+
+import numpy as np
+import pytest
+
+from splinevis.nurbs import shell
+from splinevis.nurbs.exact import box_faces, cylinder, saddle, sphere, torus
+from splinevis.nurbs.hard_cases import bumpy, degree7
+from splinevis.nurbs.model import NurbsModel
+from splinevis.nurbs.surface import NurbsSurface
+from splinevis.nurbs.tessellate import span_grid
+
+
+def _random_patch(rng, p, q, nu, nv, rational=True):
+    P = rng.normal(size=(nu, nv, 3))
+    P[..., 0] += np.arange(nu)[:, None] * 2.0
+    P[..., 1] += np.arange(nv)[None, :] * 2.0
+    U = np.r_[np.zeros(p), np.linspace(0, 1, nu - p + 1), np.ones(p)]
+    V = np.r_[np.zeros(q), np.linspace(0, 1, nv - q + 1), np.ones(q)]
+    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
+    return NurbsSurface((p, q), (U, V), P, w)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_span_turning_bounds_the_sampled_turn_of_the_tangents(seed):
+    # non-rational and product-weight patches: the tangents inside a span stay in the cone of the span's legs
+    rng = np.random.default_rng(seed)
+    p, q = rng.integers(1, 4, 2)
+    s = _random_patch(rng, int(p), int(q), int(p) + 3, int(q) + 3, rational=False)
+    for axis in (0, 1):
+        bound = shell.span_turning(s, axis)
+        knots, (lo, hi) = s.knots[axis], s.domain[axis]
+        k = np.unique(knots[(knots >= lo) & (knots <= hi)])
+        for i, (a, b) in enumerate(zip(k[:-1], k[1:])):
+            t = np.linspace(a, b, 41)[:-1]
+            o = np.linspace(*s.domain[1 - axis], 13)
+            T, O = np.meshgrid(t, o, indexing="ij")
+            uu, vv = (T, O) if axis == 0 else (O, T)
+            d = s.derivatives(uu.ravel(), vv.ravel(), 1)[:, 1, 0] if axis == 0 else \
+                s.derivatives(uu.ravel(), vv.ravel(), 1)[:, 0, 1]
+            e = d / np.linalg.norm(d, axis=-1, keepdims=True)
+            worst = np.arccos(np.clip(e @ e.T, -1, 1)).max()  # angular diameter of the sampled tangents
+            assert worst <= bound[i] + 1e-9, (axis, i, worst, bound[i])
+
+
+def test_straight_directions_get_one_cell_curved_ones_all():
+    assert shell.span_turning(cylinder(), 1).tolist() == [0.0]
+    assert np.allclose(np.degrees(shell.span_turning(cylinder(), 0)), 90.0)
+    us, vs = shell.shell_grid(cylinder(), 8)
+    assert len(us) == len(span_grid(cylinder(), 8)[0]) and vs.tolist() == [0.0, 1.0]
+    for face in box_faces():  # planes: one cell
+        assert [len(g) for g in shell.shell_grid(face, 8)] == [2, 2]
+    for s in (sphere(), torus(), saddle(), degree7(), bumpy(3, 1, 6, 2)):  # curved: the uniform grid
+        got, want = shell.shell_grid(s, 8), span_grid(s, 8)
+        for axis in (0, 1):
+            if shell.span_turning(s, axis).max() > shell.STRAIGHT:
+                assert np.array_equal(got[axis], want[axis]), (s.name, axis)
+
+
+def test_adaptive_shell_is_still_certified_and_the_uniform_one_unchanged():
+    model = NurbsModel([cylinder(), sphere(), *box_faces()])
+    pts, tris, uv, patch = shell.tessellate(model, 8, adaptive=True)
+    full = shell.tessellate(model, 8)
+    assert len(tris) < len(full[1])
+    for s in model.surfaces:
+        us, vs = shell.shell_grid(s, 8)
+        bound, dense = shell.certified_deviation(s, us, vs), shell._chord_deviation(s, us, vs, 1.0, k=32)
+        assert (bound >= dense).all()
+    # the uniform shell: span_grid's lines, as before the adaptive option existed
+    us, vs = span_grid(sphere(), 8)
+    assert shell.tessellate(NurbsModel([sphere()]), 8)[0].shape[0] == 2 * len(us) * len(vs)
+
+
+def test_patch_facts_are_computed_once_per_model():
+    model = NurbsModel([sphere(), torus(), cylinder()])
+    first = shell.patch_facts(model)
+    assert model in shell._FACTS
+    again = shell.patch_facts(model)
+    assert again == first and again is not first  # a fresh list: callers may not change the cache
+    assert [f["closed"] for f in first] == [(shell._closed(s, 0), shell._closed(s, 1)) for s in model.surfaces]
+
+
+def _v_turns_plain(seg):
+    """The plain numpy.polynomial version of trim._v_turns (what the lean one must match bit for bit)."""
+    from math import comb
+
+    p = len(seg) - 1
+    M = np.array([[comb(p, i) * comb(p - i, k - i) * (-1) ** (k - i) if k >= i else 0 for i in range(p + 1)]
+                  for k in range(p + 1)], dtype=np.float64)
+    Y, W = M @ seg[:, 1], M @ seg[:, 2]
+    Pn = np.polynomial.polynomial
+    num = Pn.polysub(Pn.polymul(Pn.polyder(Y), W), Pn.polymul(Y, Pn.polyder(W)))
+    num = np.trim_zeros(num, "b")
+    if num.size <= 1:
+        return []
+    roots = Pn.polyroots(num)
+    return sorted(float(r.real) for r in roots if abs(r.imag) < 1e-12 and 1e-12 < r.real < 1 - 1e-12)
+
+
+def test_trim_cuts_and_evaluation_match_the_plain_code_bit_for_bit():
+    from splinevis.nurbs import trim
+
+    rng = np.random.default_rng(7)
+    for p in (1, 2, 3):
+        for k in range(200):
+            seg = np.column_stack([rng.normal(size=(p + 1, 2)), rng.uniform(0.3, 2.0, p + 1)])
+            if k % 3 == 0:
+                seg[:, 2] = 1.0  # polynomial: the top coefficients cancel exactly (trailing zeros trimmed)
+            seg[:, :2] *= seg[:, 2:]
+            assert trim._v_turns(seg) == _v_turns_plain(seg)
+    ctrl = np.zeros((60, 4, 3))
+    deg = rng.integers(1, 4, 60)
+    for i, d in enumerate(deg):
+        ctrl[i, : d + 1, :2] = rng.normal(size=(d + 1, 2))
+        ctrl[i, : d + 1, 2] = rng.uniform(0.5, 2.0, d + 1)
+    t = rng.uniform(0, 1, 60)
+    f = trim._evaluator(ctrl, deg)
+    ref = trim._eval(ctrl, deg, t)
+    assert np.array_equal(f(t, 0), ref[:, 0]) and np.array_equal(f(t, 1), ref[:, 1])
+
+
+@pytest.mark.gl
+def test_gpu_cylinder_and_box_on_the_adaptive_shell_match_the_twin():
+    import splinevis
+    from splinevis.gl.camera import pixel_rays
+    from splinevis.nurbs.program import PROGRAM
+
+    model = NurbsModel([cylinder(1.0, 2.0, (3.0, 0.0, 0.0)), *box_faces(1.5, 1.0, 0.8)])
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    pl.add_nurbs(model, lights=1)
+    pl.camera_position = [(8.0, -9.0, 6.0), (1.5, 0.0, 0.5), (0, 0, 1)]
+    pl.reset_camera_clipping_range()
+    img = pl.screenshot()
+    depth, matrix = pl.depth_buffer(), pl.camera_matrix()
+    pl.close()
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref = PROGRAM.raycast(model, o, d)
+    gpu_hit = depth < 1.0
+    assert gpu_hit.mean() > 0.05
+    assert (gpu_hit != ref.hit).sum() <= 0.002 * gpu_hit.size
