@@ -259,7 +259,7 @@ def _match(X, T, face, piece, seg_len, tol, cos_min=0.5, k=16):
     tree = cKDTree(X)
     reach = tol + float(np.max(seg_len)) if n else tol
     k = min(k, n)
-    dist, idx = tree.query(X[ask], k=k, distance_upper_bound=reach)
+    dist, idx = tree.query(X[ask], k=k, distance_upper_bound=reach, workers=-1)  # same answer on any thread count
     rows, cols = np.nonzero(np.isfinite(dist))
     cand = idx[rows, cols]
     qi = ask[rows]
@@ -307,7 +307,8 @@ def orient_faces(model: NurbsModel, match: float = 1e-3, tol_gap: float = 1e-4, 
     per_span : int
         Boundary samples per knot span at least (more where chords would exceed 1/256 of the size).
     seams : bool
-        Measure the seams' continuity (second derivatives at up to 64 shared samples per face pair).
+        Measure the seams' continuity (second derivatives at up to 64 shared samples per face pair), on the
+        first read of the report (:class:`LazyReport`; ``seconds`` is the orientation's time without it).
 
     Returns
     -------
@@ -435,19 +436,97 @@ def orient_faces(model: NurbsModel, match: float = 1e-3, tol_gap: float = 1e-4, 
               "adjacent_pairs": int((total != 0).sum()), "inconsistent_pairs_before": int((total < 0).sum()),
               "conflicts": conflicts, "non_manifold_length": non_manifold_length, "ambiguous_trims": ambiguous,
               "size": size, "match": tol}
+    report["seconds"] = time.perf_counter() - start
     if seams:
         sgn = np.where(flip, -1.0, 1.0)
-        report["seams"] = _seams(surfaces, sgn, X, UV, T, face, piece, tpar, fns, qi[cross], other[cross],
-                                 js[cross], lam[cross], size, tol_gap, tol_angle_deg, tol_curvature)
-        levels = {}
-        for s in report["seams"]:
-            levels[s.level] = levels.get(s.level, 0) + 1
-        report["seam_levels"] = levels
-    report["seconds"] = time.perf_counter() - start
+        args = (surfaces, sgn, X, UV, T, face, piece, tpar, fns, qi[cross], other[cross], js[cross], lam[cross],
+                size, tol_gap, tol_angle_deg, tol_curvature)
+
+        def measure():
+            found = _seams(*args)
+            levels = {}
+            for s in found:
+                levels[s.level] = levels.get(s.level, 0) + 1
+            return {"seams": found, "seam_levels": levels}
+
+        report = LazyReport(report, measure)
     old = dict(getattr(model, "report", {}) or {})
     old["orientation"] = report
     out = dataclasses.replace(model, surfaces=tuple(new_s), trims=tuple(new_t), report=old)
     return out, report
+
+
+class LazyReport(dict):
+    """A report dict some of whose entries are measured on first use: any read of the dict (``[]``, ``get``,
+    ``in``, iteration, ``len``, printing, pickling) measures them first. The seams' continuity costs as much as
+    the orientation itself (second derivatives and curve feet at every shared sample: 1.2 s of a 288-face
+    part's 3 s), and a model read only to be drawn never looks at it.
+
+    >>> r = LazyReport({"faces": 2}, lambda: {"seams": ["measured"]})
+    >>> r["faces"], r["seams"], sorted(r)
+    (2, ['measured'], ['faces', 'seams'])
+    """
+
+    def __init__(self, data, pending):
+        super().__init__(data)
+        self._pending = pending
+
+    def _fill(self):
+        if self._pending is not None:
+            pending, self._pending = self._pending, None
+            super().update(pending())
+
+    def __missing__(self, key):
+        self._fill()
+        if dict.__contains__(self, key):
+            return dict.__getitem__(self, key)
+        raise KeyError(key)
+
+    def get(self, key, default=None):
+        self._fill()
+        return super().get(key, default)
+
+    def __contains__(self, key):
+        self._fill()
+        return super().__contains__(key)
+
+    def __iter__(self):
+        self._fill()
+        return super().__iter__()
+
+    def __len__(self):
+        self._fill()
+        return super().__len__()
+
+    def keys(self):
+        self._fill()
+        return super().keys()
+
+    def values(self):
+        self._fill()
+        return super().values()
+
+    def items(self):
+        self._fill()
+        return super().items()
+
+    def copy(self):
+        self._fill()
+        return dict(super().items())
+
+    def __repr__(self):
+        self._fill()
+        return super().__repr__()
+
+    def __eq__(self, other):
+        self._fill()
+        return super().__eq__(other)
+
+    __hash__ = None
+
+    def __reduce__(self):
+        self._fill()
+        return (dict, (dict(super().items()),))
 
 
 def _foot(surfaces, X, UV, face, piece, tpar, fns, P, js, lam, iterations=2):
@@ -515,7 +594,7 @@ def _seams(surfaces, sgn, X, UV, T, face, piece, tpar, fns, qi, other, js, lam, 
             u = into_domain(uv[idx, 0], u0, u1)
             v = into_domain(uv[idx, 1], v0, v1)
             SKL = s.derivatives(u, v, 2)
-            n = s.normal(u, v) * sgn[k]
+            n = s._normal(u, v, SKL) * sgn[k]
             n_out[idx] = n
             k_out[idx] = normal_curvature(SKL, n, np.cross(n, tang[idx]))
     angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)))

@@ -15,6 +15,7 @@ zoom: no polygon, no staircase.
 
 from __future__ import annotations
 
+import weakref
 from functools import cache
 from math import comb
 
@@ -146,21 +147,40 @@ def trim_pieces(trims) -> TrimPieces:
         n0 = len(degree)
         for loop in loops or ():
             for curve in loop:
-                if curve.degree > MAX_TRIM_DEGREE:
-                    raise ValueError(f"trim curve of degree {curve.degree}: the per-fragment trim test handles degree "
-                                     f"<= {MAX_TRIM_DEGREE}; reduce it (e.g. approximate the loop) before drawing.")
-                for seg in _bezier_segments(curve):
-                    cuts = _v_turns(seg)
-                    rest, done = seg, 0.0
-                    for t in cuts:
-                        left, rest = _split(rest, (t - done) / (1 - done))
-                        done = t
-                        _add(left, ctrl, degree, bbox)
-                    _add(rest, ctrl, degree, bbox)
+                c, d, b = _curve_pieces(curve)
+                ctrl += c
+                degree += d
+                bbox += b
         count.append(len(degree) - n0)
     n = len(degree)
     return TrimPieces(np.asarray(ctrl, dtype=np.float64).reshape(n, 4, 3), np.asarray(degree, dtype=np.int64),
                       np.asarray(bbox, dtype=np.float64).reshape(n, 4), np.asarray(start), np.asarray(count))
+
+
+def _curve_pieces(curve) -> tuple:
+    """One curve's pieces as lists (ctrl, degree, bbox), kept while the curve lives (curves are immutable; the
+    orientation pass and the program build of a read model cut the same curves)."""
+    hit = _PIECES.get(curve)
+    if hit is not None:
+        return hit
+    if curve.degree > MAX_TRIM_DEGREE:
+        raise ValueError(f"trim curve of degree {curve.degree}: the per-fragment trim test handles degree "
+                         f"<= {MAX_TRIM_DEGREE}; reduce it (e.g. approximate the loop) before drawing.")
+    ctrl, degree, bbox = [], [], []
+    for seg in _bezier_segments(curve):
+        cuts = _v_turns(seg)
+        rest, done = seg, 0.0
+        for t in cuts:
+            left, rest = _split(rest, (t - done) / (1 - done))
+            done = t
+            _add(left, ctrl, degree, bbox)
+        _add(rest, ctrl, degree, bbox)
+    out = (tuple(ctrl), tuple(degree), tuple(bbox))
+    _PIECES[curve] = out
+    return out
+
+
+_PIECES = weakref.WeakKeyDictionary()  # TrimCurve (hashed by identity) -> its pieces
 
 
 def _add(seg, ctrl, degree, bbox):
