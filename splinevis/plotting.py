@@ -22,7 +22,19 @@ import pyvista as pv  # noqa: E402  (after configure: VTK reads the window class
 
 from .gl.inject import SplineActor, capture_vtk_errors, raise_for_shader_errors  # noqa: E402
 
-__all__ = ["Plotter"]
+__all__ = ["Plotter", "companion_polydata"]
+
+
+def companion_polydata(points, cells) -> pv.PolyData:
+    """A :class:`pyvista.PolyData` of companion geometry: ``cells`` (m, 3) triangles, (m, 2) line segments or
+    (m, 1) vertices of ``points`` (see :meth:`splinevis.nurbs.NurbsModel.companion_meshes`).
+
+    >>> companion_polydata(np.eye(3), [[0, 1], [1, 2]]).n_lines
+    2
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    key = {3: "faces", 2: "lines", 1: "verts"}[cells.shape[1]]
+    return pv.PolyData(np.asarray(points, dtype=np.float64), **{key: pv.CellArray.from_regular_cells(cells)})
 
 
 def _style_from(style, style_kwargs) -> Style:
@@ -162,13 +174,15 @@ class Plotter(pv.Plotter):
         return spline
 
     def _add_companions(self, model, style, name) -> list:
-        """Draw a model's plain meshes (``model.companion_meshes()``: e.g. a CAD file's mesh objects) as ordinary
-        smooth-shaded meshes in the style's colour; returns their actors (``SplineActor.companions``)."""
+        """Draw a model's plain geometry (``model.companion_meshes()``: a CAD file's mesh objects, curves and
+        points) as ordinary smooth-shaded meshes in the style's colour, and dark lines and points; returns their
+        actors (``SplineActor.companions``)."""
         actors = []
-        for k, (label, points, triangles) in enumerate(getattr(model, "companion_meshes", lambda: ())()):
-            faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
-            mesh = pv.PolyData(points, faces)
-            actors.append(self.add_mesh(mesh, color=style.color, smooth_shading=True, reset_camera=True,
+        for k, (label, points, cells) in enumerate(getattr(model, "companion_meshes", lambda: ())()):
+            surface = np.shape(cells)[1] == 3  # curves and points dark and unlit, as CAD programs draw them
+            actors.append(self.add_mesh(companion_polydata(points, cells), reset_camera=True,
+                                        color=style.color if surface else "#202020", smooth_shading=surface,
+                                        lighting=surface, line_width=2, point_size=5,
                                         name=None if name is None else f"{name} mesh {k} ({label})"))
         return actors
 

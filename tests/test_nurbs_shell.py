@@ -140,3 +140,47 @@ def test_gpu_cylinder_and_box_on_the_adaptive_shell_match_the_twin():
     gpu_hit = depth < 1.0
     assert gpu_hit.mean() > 0.05
     assert (gpu_hit != ref.hit).sum() <= 0.002 * gpu_hit.size
+
+
+def _bunched_ruled(rows=(0.0, 0.05, 0.1, 1.0)):
+    """A ruled patch whose rulings are straight lines traced at varying speed: cubic in u with collinear
+    control points bunched 0, 0.05, 0.1, 1 (like a real fuselage's: speed ratio ~7), a half circle in v."""
+    from splinevis.nurbs.exact import circle_net
+
+    xy, w = circle_net()
+    xy, w = xy[:5], w[:5]  # two quarter arcs: half the circle
+    V = np.array([0, 0, 0, 0.5, 0.5, 1, 1, 1.0])
+    P = np.array([[[x, y, 4.0 * a] for x, y in xy] for a in rows])
+    W = np.tile(w, (len(rows), 1))
+    return NurbsSurface((3, 2), (np.array([0, 0, 0, 0, 1, 1, 1, 1.0]), V), P, W, name="bunched ruling")
+
+
+def test_a_straight_span_at_varying_speed_keeps_its_cells():
+    # the fuselage regression: turn 0 (straight) but not affine in the parameter: all cells, not one
+    s = _bunched_ruled()
+    assert shell.span_turning(s, 0).max() <= shell.STRAIGHT
+    assert shell.span_affine(s, 0).tolist() == [False]
+    assert len(shell.shell_grid(s, 8)[0]) == 9
+    even = _bunched_ruled((0.0, 1 / 3, 2 / 3, 1.0))  # the same line at constant speed: one cell
+    assert shell.span_affine(even, 0).tolist() == [True] and len(shell.shell_grid(even, 8)[0]) == 2
+
+
+@pytest.mark.gl
+def test_gpu_finds_every_hit_on_rulings_traced_at_varying_speed():
+    import splinevis
+    from splinevis.gl.camera import pixel_rays
+    from splinevis.nurbs.program import PROGRAM
+
+    model = NurbsModel([_bunched_ruled()])
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    pl.add_nurbs(model, lights=1)
+    pl.camera_position = [(5.0, -6.0, 6.0), (0.0, 0.5, 2.0), (0, 0, 1)]
+    pl.reset_camera_clipping_range()
+    img = pl.screenshot()
+    depth, matrix = pl.depth_buffer(), pl.camera_matrix()
+    pl.close()
+    o, d = pixel_rays(matrix, *img.shape[1::-1])
+    ref = PROGRAM.raycast(model, o, d)
+    gpu_hit = depth < 1.0
+    assert ref.hit.mean() > 0.05
+    assert (gpu_hit != ref.hit).sum() <= 0.002 * gpu_hit.size

@@ -23,8 +23,9 @@ What is read
   - **Every face is drawn.** Edges of real files lie farther than the model tolerance from their
     surfaces (each Brep edge has its own tolerance, which rhino3dm does not expose; v4_MechPartA.3dm has
     edges 0.009 off at tolerance 0.001, running past the surface's side); such a face gets the best loop
-    found (fitted within the tolerance plus the edge's measured distance), and a warning and the model's
-    ``source`` give its deviation and the edges' distance. The ``source`` lists each pulled-back face's
+    found (fitted within the tolerance plus the edge's measured distance); ``source`` and
+    ``report["trim_fit"]`` give its deviation and the edges' distance (a warning only where the fit stays
+    farther from the edges than their distance from the surface plus the tolerance: the reader's shortfall). The ``source`` lists each pulled-back face's
     measured deviation (max distance of the pulled-back curves, mapped through the surface, from the
     edges) and how far its edges are from the surface. Only an edge more than 100 tolerances from its
     surface (not the face's edge: a damaged Brep), or a loop that does not close, drops the face, with a
@@ -38,13 +39,18 @@ What is read
 * Names: the object's name (``Attributes.Name``), else its id (a UUID); faces of a Brep with several
   faces are ``"<name> face <k>"``.
 
-Anything else (curves, meshes, points, ...) is counted in ``skipped`` by its rhino3dm type.
+Beside the surfaces (``NurbsModel.meshes``, drawn as they are): mesh objects, curves (sampled, as line
+segments) and points and point clouds, when their object and layer are visible (hidden ones are named in
+``source``). Annotations (:data:`ANNOTATIONS`: text, dimensions, hatches, leaders; drafting objects, not the
+model's geometry) are counted in ``report["annotations"]`` and ``source``. Anything else is counted in
+``skipped`` by its rhino3dm type, with a warning.
 Rhino stores knot vectors without the two superfluous end knots and control points homogeneous
 ``(w x, w y, w z, w)``; both are converted here.
 """
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import itertools
 import warnings
@@ -56,7 +62,11 @@ from ..nurbs import NurbsModel, NurbsSurface, TrimCurve
 from ..nurbs.pullback import _Inverter, curve_evaluator, pull_back_many, reverse_curve
 from .nurbs_common import build_model, checked, flip_v
 
-__all__ = ["read_3dm"]
+__all__ = ["read_3dm", "ANNOTATIONS"]
+
+#: rhino3dm types of drafting objects (text, dimensions, hatch fills, leaders, text dots): not drawn.
+ANNOTATIONS = frozenset({"Text", "TextDot", "Hatch", "Leader", "AnnotationBase", "Dimension", "LinearDimension",
+                         "AngularDimension", "RadialDimension", "OrdinateDimension", "Centermark"})
 
 _CURVED_TRIMMED = "trimmed Brep face whose trim loops cannot be rebuilt from its edges (see the warning)"
 #: An edge farther than this many model tolerances from its face's surface (and farther than rounding,
@@ -92,8 +102,8 @@ def read_3dm(path) -> NurbsModel:
     if model is None:
         raise ValueError(f"{path}: rhino3dm could not read this file; is it a Rhino .3dm file (version <= 8)?")
     surfaces, trims, skipped, contents, pulled, stopped = [], [], {}, {}, [], []
-    meshes, hidden = [], {}
-    visible_layers = {layer.Index for layer in model.Layers if layer.Visible}
+    meshes, hidden, annotations = [], {}, {}
+    hidden_layers = {layer.Index for layer in model.Layers if not layer.Visible}  # no layer table: all shown
     tol, told = _tolerance(model)
     for obj in model.Objects:
         g, attr = obj.Geometry, obj.Attributes
@@ -101,10 +111,19 @@ def read_3dm(path) -> NurbsModel:
         contents[kind] = contents.get(kind, 0) + 1
         name = attr.Name or str(attr.Id)
         if isinstance(g, rhino3dm.Mesh):  # drawn as it is beside the surfaces, unless the file hides it
-            if attr.Visible and attr.LayerIndex in visible_layers:
+            if attr.Visible and attr.LayerIndex not in hidden_layers:
                 meshes.append(_mesh(g, name))
             else:
                 hidden[kind] = hidden.get(kind, 0) + 1
+            continue
+        if isinstance(g, (rhino3dm.Curve, rhino3dm.Point, rhino3dm.PointCloud)):  # drawn as lines and points
+            if attr.Visible and attr.LayerIndex not in hidden_layers:
+                meshes.append(_sketch(g, name, rhino3dm))
+            else:
+                hidden[kind] = hidden.get(kind, 0) + 1
+            continue
+        if kind in ANNOTATIONS:  # drafting objects, not geometry of the model
+            annotations[kind] = annotations.get(kind, 0) + 1
             continue
         if isinstance(g, rhino3dm.SubD):  # the Catmull-Clark limit surface as bicubic patches
             from .subd import subd_object_surfaces
@@ -148,10 +167,15 @@ def read_3dm(path) -> NurbsModel:
         else:
             skipped[kind] = skipped.get(kind, 0) + 1
     result = build_model(path, "Rhino 3DM (rhino3dm)", surfaces, trims, skipped, contents)
-    extra = "".join([f"; {len(meshes)} mesh object(s) drawn as meshes" if meshes else "",
+    drawn = collections.Counter({3: "mesh", 2: "curve", 1: "point"}[np.shape(c)[1]] for _, _, c in meshes)
+    extra = "".join(["; drawn beside the surfaces: " + ", ".join(f"{n} {k} object(s)" for k, n in drawn.items())
+                     if meshes else "",
                      "; not drawn, hidden in the file: " + ", ".join(f"{n} x {k}" for k, n in hidden.items())
-                     if hidden else ""])
-    result = dataclasses.replace(result, meshes=tuple(meshes), source=result.source + extra)
+                     if hidden else "",
+                     "; annotations (not geometry) not drawn: " + ", ".join(f"{n} x {k}" for k, n in annotations.items())
+                     if annotations else ""])
+    report = dict(result.report, annotations=dict(annotations)) if annotations else result.report
+    result = dataclasses.replace(result, meshes=tuple(meshes), source=result.source + extra, report=report)
     if not pulled:
         return result
     worst = sorted(pulled, reverse=True)
@@ -161,17 +185,28 @@ def read_3dm(path) -> NurbsModel:
     within = f"within {tol:.3g}" if not over else f"{len(over)} of them beyond the tolerance {tol:.3g}"
     note = (f"; trim curves pulled back onto {len(pulled)} face(s) {within} ({told}), max deviation per face: "
             f"{listing}{more}")
+    fit = {"tolerance": tol, "faces": {n: {"deviation": d, "edge_distance": e} for d, e, n in worst},
+           "beyond_tolerance": [n for _, _, n in over], "short_of_edges": []}
     if over:
         names = ", ".join(f"{n!r} {d:.3g} (edges {e:.3g} off)" for d, e, n in over[:_MAX_LISTED])
         more = f", {len(over) - _MAX_LISTED} more" if len(over) > _MAX_LISTED else ""
-        text = (f"{len(over)} face(s) drawn with trim loops beyond the model tolerance {tol:.3g}, the best fit of "
-                f"edges that lie farther than that from their surfaces (the Brep's own edge tolerances): {names}"
-                f"{more}")
+        note += (f"; {len(over)} face(s) drawn with trim loops beyond the model tolerance {tol:.3g}, the best fit of "
+                 f"edges that lie farther than that from their surfaces (the Brep's own edge tolerances): {names}"
+                 f"{more}")
+    # the fit can come no nearer to an edge than the edge is to the surface; a warning only where it stayed
+    # farther than that plus the tolerance (the reader's shortfall, not the file's)
+    short = [(d, e, n) for d, e, n in over if d > e + tol]
+    if short:
+        fit["short_of_edges"] = [n for _, _, n in short]
+        names = ", ".join(f"{n!r} {d:.3g} (edges {e:.3g} off)" for d, e, n in short[:_MAX_LISTED])
+        more = f", {len(short) - _MAX_LISTED} more" if len(short) > _MAX_LISTED else ""
+        text = (f"{len(short)} face(s) drawn with trim loops farther from their edges than the edges are from the "
+                f"surface plus the tolerance {tol:.3g}: {names}{more}")
         if stopped:
             text += f"; refinement stopped: {stopped[0]}" + (f" ({len(stopped) - 1} more)" if len(stopped) > 1 else "")
         warnings.warn(f"{path}: {text}", UserWarning, stacklevel=2)
         note += f"; {text}"
-    return dataclasses.replace(result, source=result.source + note)
+    return dataclasses.replace(result, source=result.source + note, report=dict(result.report, trim_fit=fit))
 
 
 def _mesh(g, name: str) -> tuple:
@@ -182,6 +217,24 @@ def _mesh(g, name: str) -> tuple:
     quad = F[:, 2] != F[:, 3]
     T = np.concatenate([F[:, :3], F[quad][:, [0, 2, 3]]])
     return name, P, T
+
+
+def _sketch(g, name: str, rhino3dm) -> tuple:
+    """A curve as ``(name, points, segments (m, 2))`` (sampled at 64 points per span of its NURBS form, at
+    most 4096: a circle's chords then lie within 1.2e-3 of its radius, under a pixel at any whole-model
+    view), a point or point cloud as ``(name, points, vertices (m, 1))``."""
+    if isinstance(g, rhino3dm.Point):
+        P = np.array([[g.Location.X, g.Location.Y, g.Location.Z]])
+    elif isinstance(g, rhino3dm.PointCloud):
+        P = np.array([[q.X, q.Y, q.Z] for q in g.GetPoints()], dtype=np.float64).reshape(-1, 3)
+    else:
+        dom = g.Domain
+        n = int(min(4096, 64 * max(1, g.SpanCount)))
+        t = dom.T0 + (dom.T1 - dom.T0) * np.linspace(0.0, 1.0, n + 1)
+        t[-1] = dom.T1
+        P = np.array([[q.X, q.Y, q.Z] for q in map(g.PointAt, t)], dtype=np.float64)
+        return name, P, np.column_stack([np.arange(n), np.arange(1, n + 1)])
+    return name, P, np.arange(len(P)).reshape(-1, 1)
 
 
 def _tolerance(model):

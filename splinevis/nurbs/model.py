@@ -94,9 +94,10 @@ class NurbsModel:
         Findings about the model (e.g. ``report["orientation"]`` from
         :func:`splinevis.nurbs.orient.orient_faces`: faces flipped, shells closed, seams' continuity); empty
         by default.
-    meshes : sequence of (name, points (n, 3), triangles (m, 3))
-        Plain triangle meshes the file holds beside its surfaces (a CAD file's mesh objects), drawn as they are
-        next to the exact surfaces (:meth:`companion_meshes`); empty by default.
+    meshes : sequence of (name, points (n, 3), cells (m, k))
+        Plain geometry the file holds beside its surfaces, drawn as it is next to the exact surfaces
+        (:meth:`companion_meshes`): triangles (k = 3: a CAD file's mesh objects), line segments (k = 2: its
+        curves, sampled) or points (k = 1); empty by default.
 
     Examples
     --------
@@ -130,17 +131,22 @@ class NurbsModel:
         meshes = []
         for k, (name, points, triangles) in enumerate(self.meshes):
             P = np.asarray(points, dtype=np.float64)
-            T = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+            T = np.asarray(triangles, dtype=np.int64)
+            T = T.reshape(-1, 3) if T.ndim != 2 else T
             if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
                 raise ValueError(f"meshes[{k}] ({name!r}): points must be a finite (n, 3) array, got shape {P.shape}.")
+            if T.shape[1] not in (1, 2, 3):
+                raise ValueError(f"meshes[{k}] ({name!r}): cells must be triangles (m, 3), segments (m, 2) or "
+                                 f"points (m, 1), got shape {T.shape}.")
             if T.size and (T.min() < 0 or T.max() >= len(P)):
-                raise ValueError(f"meshes[{k}] ({name!r}): a triangle refers to point {int(T.max())} of {len(P)}.")
+                raise ValueError(f"meshes[{k}] ({name!r}): a cell refers to point {int(T.max())} of {len(P)}.")
             meshes.append((str(name), P, T))
         object.__setattr__(self, "meshes", tuple(meshes))
 
     def companion_meshes(self) -> tuple:
-        """The plain meshes drawn beside the surfaces: ``(name, points, triangles)`` each (the Plotter draws any
-        model's ``companion_meshes`` as ordinary meshes).
+        """The plain geometry drawn beside the surfaces: ``(name, points, cells)`` each, cells triangles,
+        segments or points (the Plotter draws any model's ``companion_meshes`` as ordinary meshes, lines and
+        points).
 
         >>> from splinevis.nurbs.exact import saddle
         >>> m = NurbsModel([saddle()], meshes=[("tri", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])])

@@ -62,6 +62,7 @@ from .continuity import Seam, classify, normal_curvature
 from .model import NurbsModel, TrimCurve
 from .surface import NurbsSurface
 from .shell_volume import _breaks, _piece_params, signed_volumes
+from .lazy_report import LazyReport
 from .trim import inside, trim_pieces
 
 __all__ = ["flip_u", "orient_faces"]
@@ -454,79 +455,6 @@ def orient_faces(model: NurbsModel, match: float = 1e-3, tol_gap: float = 1e-4, 
     old["orientation"] = report
     out = dataclasses.replace(model, surfaces=tuple(new_s), trims=tuple(new_t), report=old)
     return out, report
-
-
-class LazyReport(dict):
-    """A report dict some of whose entries are measured on first use: any read of the dict (``[]``, ``get``,
-    ``in``, iteration, ``len``, printing, pickling) measures them first. The seams' continuity costs as much as
-    the orientation itself (second derivatives and curve feet at every shared sample: 1.2 s of a 288-face
-    part's 3 s), and a model read only to be drawn never looks at it.
-
-    >>> r = LazyReport({"faces": 2}, lambda: {"seams": ["measured"]})
-    >>> r["faces"], r["seams"], sorted(r)
-    (2, ['measured'], ['faces', 'seams'])
-    """
-
-    def __init__(self, data, pending):
-        super().__init__(data)
-        self._pending = pending
-
-    def _fill(self):
-        if self._pending is not None:
-            pending, self._pending = self._pending, None
-            super().update(pending())
-
-    def __missing__(self, key):
-        self._fill()
-        if dict.__contains__(self, key):
-            return dict.__getitem__(self, key)
-        raise KeyError(key)
-
-    def get(self, key, default=None):
-        self._fill()
-        return super().get(key, default)
-
-    def __contains__(self, key):
-        self._fill()
-        return super().__contains__(key)
-
-    def __iter__(self):
-        self._fill()
-        return super().__iter__()
-
-    def __len__(self):
-        self._fill()
-        return super().__len__()
-
-    def keys(self):
-        self._fill()
-        return super().keys()
-
-    def values(self):
-        self._fill()
-        return super().values()
-
-    def items(self):
-        self._fill()
-        return super().items()
-
-    def copy(self):
-        self._fill()
-        return dict(super().items())
-
-    def __repr__(self):
-        self._fill()
-        return super().__repr__()
-
-    def __eq__(self, other):
-        self._fill()
-        return super().__eq__(other)
-
-    __hash__ = None
-
-    def __reduce__(self):
-        self._fill()
-        return (dict, (dict(super().items()),))
 
 
 def _foot(surfaces, X, UV, face, piece, tpar, fns, P, js, lam, iterations=2):

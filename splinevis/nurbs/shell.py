@@ -21,7 +21,7 @@ from .poles import pole_tables
 from .surface import NurbsSurface
 from .tessellate import span_grid
 
-__all__ = ["model_offset", "patch_facts", "span_turning", "shell_grid", "tessellate", "certified_deviation",
+__all__ = ["model_offset", "patch_facts", "span_turning", "span_affine", "shell_grid", "tessellate", "certified_deviation",
            "STRAIGHT"]
 
 
@@ -149,6 +149,36 @@ def span_turning(s: NurbsSurface, axis: int) -> np.ndarray:
     return np.maximum(angle.max(axis=1), turn)
 
 
+def span_affine(s: NurbsSurface, axis: int) -> np.ndarray:
+    """Per non-empty knot span along ``axis``: True where every isoparametric curve along ``axis`` is an affine
+    function of the parameter there (a sufficient test: each column's control points of the span are
+    ``A + B xi`` at their Greville abscissae ``xi``, to 1e-9 of the net's size, so the curve is ``A + B t`` by
+    linear precision, ``sum_i N_i(t) xi_i = t``; and the weights are constant along ``axis``, so they cancel).
+
+    >>> from splinevis.nurbs.exact import cylinder
+    >>> span_affine(cylinder(), 1).tolist()  # the rulings: two control rows, a line at constant speed
+    [True]
+    """
+    P = np.moveaxis(s.control_points, axis, 0)
+    p, U = s.degree[axis], s.knots[axis]
+    nu = P.shape[0]
+    iu = np.flatnonzero(U[p:nu] < U[p + 1: nu + 1]) + p
+    xi = np.array([U[i + 1: i + p + 1].mean() for i in range(nu)])  # Greville abscissae
+    rows = iu[:, None] - p + np.arange(p + 1)
+    X = xi[rows]
+    dx = X - X.mean(axis=1, keepdims=True)
+    Q = P[rows]  # (spans, p + 1, other, 3)
+    dQ = Q - Q.mean(axis=1, keepdims=True)
+    ss = (dx**2).sum(axis=1)
+    B = np.einsum("sk,skvc->svc", dx, dQ) / np.where(ss > 0, ss, 1.0)[:, None, None]
+    resid = np.abs(dQ - dx[:, :, None, None] * B[:, None]).max(axis=(1, 2, 3))
+    ok = (resid <= 1e-9 * (1.0 + np.abs(P).max())) & (ss > 0)
+    if s.weights is not None:
+        W = np.moveaxis(s.weights, axis, 0)[rows]  # (spans, p + 1, other)
+        ok &= np.ptp(W, axis=1).max(axis=1) <= 1e-12 * W.max()
+    return ok
+
+
 #: Turning (radians) up to which a knot span counts as straight in the adaptive shell (:func:`shell_grid`): the
 #: precision of the bound's arccos near 1 (~1e-8) with room to spare.
 STRAIGHT = 1e-6
@@ -156,10 +186,13 @@ STRAIGHT = 1e-6
 
 def shell_grid(s: NurbsSurface, subdivisions: int) -> tuple:
     """Parameter lines ``(us, vs)`` of the GPU shell: each non-empty knot span cut into ``subdivisions`` parts
-    as :func:`splinevis.nurbs.tessellate.span_grid` does, except where its curves are straight
-    (:func:`span_turning` at most STRAIGHT: planes, the rulings of cylinders, cones and extrusions): one cell
-    there. Along a straight direction the cell's linear interpolation of the parameter is as good a Newton
-    start as any finer one, and a ray cannot meet a line twice; on llvmpipe every small triangle costs the
+    as :func:`splinevis.nurbs.tessellate.span_grid` does, except where its curves are straight lines traced
+    at constant speed (:func:`span_turning` at most STRAIGHT and :func:`span_affine`: planes, the rulings of
+    cylinders, cones and extrusions as CAD systems write them): one cell there. There the cell's linear
+    interpolation of the parameter is the exact parameter along that direction, and a ray cannot meet a line
+    twice. A straight span traced at varying speed keeps its cells (a fuselage's rulings whose control points
+    bunch up 7 : 1: one cell there started Newton so far off that stripes of pixels found no hit within the
+    shader's steps). On llvmpipe every small triangle costs the
     fragment program of a whole 4 x 4 pixel block, so a plane drawn as 8 x 8 cells (256 triangles in two
     layers) costs far more than its 4 triangles. Curved spans keep all their cells: cutting a span that turns
     only 10 degrees into 2 instead of 8 cells already loses the nearer of two roots of grazing rays (a dark
@@ -175,7 +208,7 @@ def shell_grid(s: NurbsSurface, subdivisions: int) -> tuple:
         knots, (lo, hi) = s.knots[axis], s.domain[axis]
         k = np.unique(knots[(knots >= lo) & (knots <= hi)])
         turn = span_turning(s, axis)
-        n = np.where(turn <= STRAIGHT, 1, subdivisions)
+        n = np.where((turn <= STRAIGHT) & span_affine(s, axis), 1, subdivisions)
         out.append(np.concatenate([at_fraction(a, b, np.linspace(0.0, 1.0, c + 1)[:-1])
                                    for a, b, c in zip(k[:-1], k[1:], n)] + [[hi]]))
     return tuple(out)
