@@ -14,8 +14,9 @@ Each model is timed in a fresh Python process (imports done first, not timed), s
 Models: ``bug27693_cornetta-step.stp`` (110 faces) and ``hammer.iges`` (45 faces) from ``../shared/data/nurbs``
 (skipped with a message when that folder is absent; ``SPLINEVIS_NURBS_DATA`` points elsewhere), and the synthetic
 ones that are always there: 10 Newell teapots (320 bicubic patches, untrimmed) and, with the ``cad`` extra
-(OpenCASCADE), 9 filleted plates with 6 holes each written to STEP and read back (288 trimmed faces: planes,
-cylinders and spheres as CAD systems write them).
+(OpenCASCADE), 9 filleted plates with 6 holes each written to STEP (solids) and to IGES (144 trimmed surfaces
+without topology, oriented by adjacency on reading) and read back (288 trimmed faces: planes, cylinders and
+spheres as CAD systems write them).
 
     python benchmarks/bench_nurbs_files.py [--repeats 3] [--out out/bench]
 
@@ -82,8 +83,9 @@ def _data_dir() -> Path:
     return Path(os.environ.get("SPLINEVIS_NURBS_DATA", ROOT.parent / "shared" / "data" / "nurbs"))
 
 
-def _plates_file(folder: Path) -> Path | None:
-    """9 filleted plates with holes as a STEP file (288 trimmed faces), or None without OpenCASCADE."""
+def _plates_file(folder: Path, suffix: str = ".step") -> Path | None:
+    """9 filleted plates with holes as a STEP (solids) or IGES (144 faces) file, 288 trimmed faces, or None
+    without OpenCASCADE."""
     try:
         import OCP  # noqa: F401
     except ImportError:
@@ -91,7 +93,7 @@ def _plates_file(folder: Path) -> Path | None:
     sys.path.insert(0, str(ROOT))
     from datasets_synthetic.cad_parts import plates
 
-    path = folder / "plates9.step"
+    path = folder / f"plates9{suffix}"
     plates(path, copies=9)
     return path
 
@@ -132,6 +134,7 @@ def bench_nurbs_files(repeats: int = 3, quick: bool = False) -> list:
             notes.append("skipped the 288-face plates: needs OpenCASCADE (the cad extra)")
         else:
             cases.append(("9 plates (STEP, synthetic)", "file", str(plates)))
+            cases.append(("9 plates (IGES 144, synthetic)", "file", str(_plates_file(Path(tmp), ".igs"))))
         cases.append(("10 teapots (synthetic)", "teapots", "10"))
         for name, kind, arg in cases:
             rows.append({"model": name, **_median([_run(kind, arg) for _ in range(repeats)])})

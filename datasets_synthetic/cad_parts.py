@@ -54,8 +54,10 @@ def plate_shape(size=(6.0, 4.0, 1.0), fillet: float = 0.3, holes=(3, 2), radius:
 
 
 def plates(path, copies: int = 16, spacing: float = 8.0, **options):
-    """``copies`` plates (:func:`plate_shape`) on a square grid ``spacing`` apart, one STEP assembly written to
-    ``path`` and read back (:func:`splinevis.io.read_nurbs`): 32 trimmed faces a plate."""
+    """``copies`` plates (:func:`plate_shape`) on a square grid ``spacing`` apart, written to ``path`` and read
+    back (:func:`splinevis.io.read_nurbs`): 32 trimmed faces a plate. A ``.step``/``.stp`` path gets one STEP
+    assembly of solids; an ``.igs``/``.iges`` path IGES faces mode (entity 144 trimmed surfaces, no topology and
+    no outside: what many CAD exports hold)."""
     import math
 
     from OCP.BRep import BRep_Builder
@@ -76,7 +78,14 @@ def plates(path, copies: int = 16, spacing: float = 8.0, **options):
         move = gp_Trsf()
         move.SetTranslation(gp_Vec(spacing * (k % side), spacing * (k // side), 0.0))
         builder.Add(compound, BRepBuilderAPI_Transform(one, move, True).Shape())
-    writer = STEPControl_Writer()
-    writer.Transfer(compound, STEPControl_AsIs)
+    if Path(path).suffix.lower() in (".igs", ".iges"):
+        from OCP.IGESControl import IGESControl_Writer
+
+        writer = IGESControl_Writer("MM", 0)  # faces mode: 144 trimmed surfaces
+        writer.AddShape(compound)
+        writer.ComputeModel()
+    else:
+        writer = STEPControl_Writer()
+        writer.Transfer(compound, STEPControl_AsIs)
     writer.Write(str(Path(path)))
     return read_nurbs(path)

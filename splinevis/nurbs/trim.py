@@ -79,47 +79,55 @@ def _split(seg, t):
 
 
 def _v_turns(seg) -> list:
-    """Parameters in (0, 1) where v(t) = Y/W turns: real roots of Y' W - Y W' (power basis).
-
-    The same arithmetic as ``numpy.polynomial.polynomial`` (polyder, polymul, polysub, polyroots: the same
-    products, convolutions and trimmed trailing zeros, so the same bits) without its per-call checks; a line
-    (degree 1) has the constant numerator ``y1 w0 - y0 w1`` (its t coefficient is ``Y_1 W_1 - Y_1 W_1 = 0``
-    exactly) and never turns.
+    """Parameters in (0, 1) where v(t) = Y/W turns: real roots of Y' W - Y W' (power basis; one segment of
+    :func:`_v_turns_all`). A line (degree 1) has the constant numerator ``y1 w0 - y0 w1`` and never turns.
 
     >>> _v_turns(np.array([[0.0, 0.0, 1.0], [0.5, 1.0, 1.0], [1.0, 0.0, 1.0]]))  # a parabola's apex
     [0.5]
     """
-    p = len(seg) - 1
-    if p <= 1:
-        return []
+    return _v_turns_all(np.asarray(seg, dtype=np.float64)[None])[0]
+
+
+def _v_turns_all(segs) -> list:
+    """:func:`_v_turns` of every segment of ``segs`` (k, p + 1, 3) at once: per segment the sorted parameters in
+    (0, 1) where v(t) turns. The numerators ``Y' W - Y W'`` in power form for all segments together, their
+    trailing exact zeros dropped per segment, then the roots of those of each degree together (a line's root
+    directly, the rest from batched companion matrices, as ``polyroots`` builds them one by one).
+
+    >>> _v_turns_all(np.array([[[0.0, 0.0, 1.0], [0.5, 1.0, 1.0], [1.0, 0.0, 1.0]]] * 2))
+    [[0.5], [0.5]]
+    """
+    segs = np.asarray(segs, dtype=np.float64)
+    k, p = len(segs), segs.shape[1] - 1
+    out = [[] for _ in range(k)]
+    if p <= 1 or k == 0:
+        return out
     M = _power_matrix(p)
-    Y, W = M @ seg[:, 1], M @ seg[:, 2]
-    dY, dW = Y[1:] * np.arange(1, p + 1), W[1:] * np.arange(1, p + 1)  # polyder: j * c[j]
-    a = _trimseq(np.convolve(_trimseq(dY), _trimseq(W)))  # polymul trims its inputs and its result
-    b = _trimseq(np.convolve(_trimseq(Y), _trimseq(dW)))
-    if len(a) > len(b):  # polysub
-        num = a.copy()
-        num[: b.size] -= b
-    else:
-        num = -b
-        num[: a.size] += a
-    num = _trimseq(num)
-    num = num[: np.flatnonzero(num)[-1] + 1] if num.any() else num[:0]  # np.trim_zeros(num, "b")
-    if num.size <= 1:
-        return []
-    roots = Pn.polyroots(num)
-    return sorted(float(r.real) for r in roots if abs(r.imag) < 1e-12 and 1e-12 < r.real < 1 - 1e-12)
-
-
-Pn = np.polynomial.polynomial
-
-
-def _trimseq(c):
-    """numpy.polynomial.polyutils.trimseq: trailing zeros dropped, at least one coefficient kept."""
-    i = len(c)
-    while i > 1 and c[i - 1] == 0:
-        i -= 1
-    return c[:i]
+    Y, W = segs[:, :, 1] @ M.T, segs[:, :, 2] @ M.T
+    j = np.arange(1, p + 1)
+    dY, dW = Y[:, 1:] * j, W[:, 1:] * j
+    num = np.zeros((k, 2 * p))
+    for a in range(p):  # num = dY * W - Y * dW as polynomial products
+        num[:, a: a + p + 1] += dY[:, a: a + 1] * W - Y * dW[:, a: a + 1]
+    # the t^(2p-1) terms, p Y_p W_p - p Y_p W_p, cancel in exact arithmetic; in floating point they leave a
+    # rounding residue that would make a spurious huge root and perturb the others: dropped
+    num = num[:, : 2 * p - 1]
+    nz = num != 0
+    deg = np.where(nz.any(axis=1), 2 * p - 2 - np.argmax(nz[:, ::-1], axis=1), 0)
+    for d in np.unique(deg[deg >= 1]):
+        rows = np.flatnonzero(deg == d)
+        c = num[rows, : d + 1]
+        if d == 1:
+            roots = (-c[:, 0] / c[:, 1])[:, None].astype(complex)
+        else:
+            comp = np.zeros((len(rows), d, d))
+            comp[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+            comp[:, :, -1] = -c[:, :-1] / c[:, -1:]
+            roots = np.linalg.eigvals(comp[:, ::-1, ::-1])
+        keep = (np.abs(roots.imag) < 1e-12) & (roots.real > 1e-12) & (roots.real < 1 - 1e-12)
+        for r, row, ok in zip(roots.real, rows, keep):
+            out[row] = sorted(float(x) for x in r[ok])
+    return out
 
 
 @cache
@@ -142,19 +150,23 @@ def trim_pieces(trims) -> TrimPieces:
     ([4], [2, 2, 2, 2])
     """
     ctrl, degree, bbox, start, count = [], [], [], [], []
+    total = 0
     for loops in trims:
-        start.append(len(degree))
-        n0 = len(degree)
+        start.append(total)
+        n0 = total
         for loop in loops or ():
             for curve in loop:
                 c, d, b = _curve_pieces(curve)
-                ctrl += c
-                degree += d
-                bbox += b
-        count.append(len(degree) - n0)
-    n = len(degree)
-    return TrimPieces(np.asarray(ctrl, dtype=np.float64).reshape(n, 4, 3), np.asarray(degree, dtype=np.int64),
-                      np.asarray(bbox, dtype=np.float64).reshape(n, 4), np.asarray(start), np.asarray(count))
+                ctrl.append(c)
+                degree.append(d)
+                bbox.append(b)
+                total += len(d)
+        count.append(total - n0)
+    if not ctrl:
+        return TrimPieces(np.zeros((0, 4, 3)), np.zeros(0, dtype=np.int64), np.zeros((0, 4)), np.asarray(start),
+                          np.asarray(count))
+    return TrimPieces(np.concatenate(ctrl), np.concatenate(degree).astype(np.int64), np.concatenate(bbox),
+                      np.asarray(start), np.asarray(count))
 
 
 def _curve_pieces(curve) -> tuple:
@@ -166,30 +178,27 @@ def _curve_pieces(curve) -> tuple:
     if curve.degree > MAX_TRIM_DEGREE:
         raise ValueError(f"trim curve of degree {curve.degree}: the per-fragment trim test handles degree "
                          f"<= {MAX_TRIM_DEGREE}; reduce it (e.g. approximate the loop) before drawing.")
-    ctrl, degree, bbox = [], [], []
-    for seg in _bezier_segments(curve):
-        cuts = _v_turns(seg)
+    segs = _bezier_segments(curve)
+    pieces = []
+    for seg, cuts in zip(segs, _v_turns_all(segs)):
         rest, done = seg, 0.0
         for t in cuts:
             left, rest = _split(rest, (t - done) / (1 - done))
             done = t
-            _add(left, ctrl, degree, bbox)
-        _add(rest, ctrl, degree, bbox)
-    out = (tuple(ctrl), tuple(degree), tuple(bbox))
+            pieces.append(left)
+        pieces.append(rest)
+    seg = np.asarray(pieces).reshape(len(pieces), curve.degree + 1, 3)
+    ctrl = np.zeros((len(seg), 4, 3))
+    ctrl[:, : curve.degree + 1] = seg
+    pts = seg[:, :, :2] / seg[:, :, 2:3]
+    bbox = np.column_stack([pts[..., 0].min(axis=1), pts[..., 0].max(axis=1), pts[..., 1].min(axis=1),
+                            pts[..., 1].max(axis=1)])
+    out = (ctrl, np.full(len(seg), curve.degree), bbox)
     _PIECES[curve] = out
     return out
 
 
 _PIECES = weakref.WeakKeyDictionary()  # TrimCurve (hashed by identity) -> its pieces
-
-
-def _add(seg, ctrl, degree, bbox):
-    pts = seg[:, :2] / seg[:, 2:3]
-    c = np.zeros((4, 3))
-    c[: len(seg)] = seg
-    ctrl.append(c)
-    degree.append(len(seg) - 1)
-    bbox.append([pts[:, 0].min(), pts[:, 0].max(), pts[:, 1].min(), pts[:, 1].max()])
 
 
 def _eval(ctrl, deg, t):
