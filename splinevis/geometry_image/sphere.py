@@ -23,8 +23,8 @@ It is built in three stages, each of which keeps it one-to-one:
    (factored every 4th step). A step must lower the energy (Armijo); where it would flip a triangle it is
    halved for that triangle's vertices until none flips (:func:`_safe_step`).
 
-The result is checked, not assumed, to be one-to-one: no triangle may have ``det[a, b, c] <= 0`` (they are
-outward oriented), and the spherical triangles' areas must sum to ``4 pi``. That sum is ``4 pi`` times the map's
+The result is checked, not assumed, to be one-to-one: every triangle must have ``det[a, b, c] > DET_BOUND``
+(outward oriented beyond rounding), and the spherical triangles' areas must sum to ``4 pi``. That sum is ``4 pi`` times the map's
 degree, so it tells a one-to-one map from one wrapping the sphere twice without flipping a triangle; the
 tolerance :data:`AREA_TOLERANCE` is far above rounding (``~1e-16`` per triangle) and far below the ``4 pi``
 between degrees.
@@ -46,10 +46,16 @@ from .mobius import center_on_sphere
 from .stretch import StretchEnergy
 from .validate import check_genus0
 
-__all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE"]
+__all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE", "DET_BOUND"]
 
 #: Largest accepted ``|sum of spherical triangle areas - 4 pi|`` (see the module docstring).
 AREA_TOLERANCE = 1e-6
+
+#: Smallest ``det[a, b, c]`` of unit vectors that counts as outward: the rounding error of ``a . (b x c)`` is at
+#: most ``5 u sum_i |a_i| (|b_j c_k| + |b_k c_j|) <= 5 sqrt(2) u`` (two products and a difference per component
+#: of the cross product, three products and two sums in the dot product; ``u`` the unit roundoff, first order,
+#: Cauchy-Schwarz), so a computed det above ``8 u`` is positive in exact arithmetic too.
+DET_BOUND = 8 * np.finfo(np.float64).eps / 2
 
 
 @dataclass(frozen=True)
@@ -69,7 +75,7 @@ class SphericalMap:
     stretch : dict
         The map's L2 stretch and area distortion (:func:`spherical_parametrization`).
     flipped : int
-        Triangles with ``det[a, b, c] <= 0`` on the sphere: 0.
+        Triangles with ``det[a, b, c] <= DET_BOUND`` on the sphere (flipped or flat within rounding): 0.
     timings : dict
         Seconds per stage.
 
@@ -207,7 +213,7 @@ def _safe_step(X, d, lam, F, incident):
     halved = np.zeros(len(X), dtype=np.int64)
     faces = np.arange(len(F))
     while True:
-        bad = faces[_det(Y, F[faces]) <= 0.0]
+        bad = faces[~(_det(Y, F[faces]) > DET_BOUND)]
         if not bad.size:
             return Y
         moved = np.unique(F[bad])
@@ -382,11 +388,11 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     timings["check"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return SphericalMap(points=_frozen(P, np.float64), faces=_frozen(F, np.int64), sphere=_frozen(X, np.float64),
-                        stretch=stretch, flipped=int((_det(X, F) <= 0).sum()), timings=timings)
+                        stretch=stretch, flipped=int((~(_det(X, F) > DET_BOUND)).sum()), timings=timings)
 
 
 def _check_one_to_one(X, F, name, what):
-    flipped = int((_det(X, F) <= 0).sum())
+    flipped = int((~(_det(X, F) > DET_BOUND)).sum())
     area = _spherical_area_sum(X, F)
     if flipped or abs(area - 4 * np.pi) > AREA_TOLERANCE:
         raise RuntimeError(f"{name}: {what} is not one-to-one: {flipped} flipped triangles, spherical area "

@@ -1,0 +1,322 @@
+"""A one-to-one start for the spherical parametrization of meshes a one-shot Tutte embedding cannot handle
+(scans with legs, ears and fingers), coarse to fine as Praun and Hoppe build theirs [PraunHoppe2003, sec. 3]:
+
+1. **Simplify** by half-edge collapses ``v -> u`` (``v`` removed, its triangles given to ``u``; the two
+   triangles on the edge vanish), in rounds: each round collapses, shortest edge first, a set of vertices whose
+   closed neighbourhoods are pairwise disjoint, so the collapses of a round do not interact and each keeps the
+   mesh a closed genus-0 manifold when it passes the link condition (``u`` and ``v`` share exactly the two
+   neighbours opposite their edge, each of degree 4 or more). Rounds go on down to a tetrahedron, or until no
+   collapse is allowed.
+2. **Embed the base**: a tetrahedron's four vertices at a regular tetrahedron's, two of them swapped if the
+   triangles come out clockwise (every triangle of a tetrahedron on those points is then outward); any other
+   base by the Tutte start of :mod:`.sphere`.
+3. **Re-insert** the rounds in reverse. A removed ``v`` goes near ``u``, inside the corner its two lost
+   triangles span there: at ``unit(X_u + s d)`` for a direction ``d`` into that corner, ``s`` halved until all
+   of ``v``'s triangles are outward (``det[a, b, c] > 0``). For small ``s`` they are: ``v``'s other triangles
+   tend to ``u``'s old ones, which were outward, and the two new ones open inside the corner. Each inserted
+   vertex then moves to the analytic centre of the region where all its triangles are outward (its ring's
+   kernel, an intersection of hemispheres), so no triangle is left a hair from flat; and the stretch of the
+   whole level is relaxed after every round while it is small, then whenever it has grown by a quarter (:func:`.sphere._relax`, which never flips
+   a triangle). Every level is so one-to-one by construction; the final check of :mod:`.sphere` confirms it.
+
+Why coarse to fine: a Tutte (harmonic) embedding shrinks a protrusion exponentially along its length: the feet
+of a four-legged scan came out with ``|det| ~ 1e-17``, below double precision, so flipped. Here every vertex is
+placed among neighbours already spread out by the relaxation of the coarser levels.
+
+Why our own code: no kept library records the collapses of a simplification (pymeshlab decimates without
+them) or embeds on the sphere; this is numpy and scipy.sparse.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .sphere import DET_BOUND
+
+__all__ = ["simplify", "hierarchical_sphere", "RELAX_ALWAYS", "GROWTH"]
+
+#: Levels up to this many vertices are relaxed after every round (cheap, and where a squeezed triangle would
+#: leave the next vertex no room); larger ones when the vertex count has grown by :data:`GROWTH`.
+RELAX_ALWAYS = 5000
+GROWTH = 1.25
+
+
+def _unit(x):
+    return x / np.linalg.norm(x, axis=-1, keepdims=True)
+
+
+def _det(X, F):
+    return np.einsum("ij,ij->i", X[F[:, 0]], np.cross(X[F[:, 1]], X[F[:, 2]]))
+
+
+def _adjacency(F, n):
+    from scipy.sparse import coo_matrix
+
+    i = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    j = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    A = coo_matrix((np.ones(i.size, dtype=np.int64), (i, j)), shape=(n, n)).tocsr()
+    return ((A + A.T) > 0).astype(np.int64).tocsr()
+
+
+def _candidate_edges(P, F, A, deg):
+    """Directed edges ``v -> u`` that pass the link condition, with their length: ``(v, u, length)``."""
+    # each directed half-edge (a -> b) of a triangle (a, b, c) has c opposite; the edge's two triangles give its
+    # two opposite vertices
+    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    c = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
+    n = A.shape[0]
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    key, a, b, c = key[order], a[order], b[order], c[order]
+    # closed manifold: every edge key appears exactly twice, consecutively
+    first, second = slice(0, None, 2), slice(1, None, 2)
+    x, y = c[first], c[second]
+    lo, hi = np.minimum(a[first], b[first]), np.maximum(a[first], b[first])
+    common = np.asarray((A[lo].multiply(A[hi])).sum(axis=1)).ravel()  # shared neighbours of the edge's ends
+    ok = (common == 2) & (deg[x] > 3) & (deg[y] > 3)
+    v = np.concatenate([lo[ok], hi[ok]])
+    u = np.concatenate([hi[ok], lo[ok]])
+    ok_v = deg[v] >= 3
+    v, u = v[ok_v], u[ok_v]
+    return v, u, np.linalg.norm(P[v] - P[u], axis=1)
+
+
+def _incidence(F, n):
+    """Sparse (V, F): vertex -> its triangles."""
+    from scipy.sparse import coo_matrix
+
+    rows = F.ravel()
+    cols = np.repeat(np.arange(len(F)), 3)
+    return coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n, len(F))).tocsr()
+
+
+def _keeps_shape(P, star, v, u) -> bool:
+    """Whether collapsing ``v`` into ``u`` leaves each of ``v``'s other triangles (``star``: all of ``v``'s) a
+    proper triangle turned less than 90 degrees: the coarse levels stay surfaces the stretch can be measured on
+    (a triangle of zero area has no stretch, and its cotangent weights are infinite)."""
+    keep = star[~(star == u).any(axis=1)]
+    moved = np.where(keep == v, u, keep)
+    before = np.cross(P[keep[:, 1]] - P[keep[:, 0]], P[keep[:, 2]] - P[keep[:, 0]])
+    after = np.cross(P[moved[:, 1]] - P[moved[:, 0]], P[moved[:, 2]] - P[moved[:, 0]])
+    size = np.linalg.norm(before, axis=1)
+    new = np.linalg.norm(after, axis=1)
+    return bool(((np.einsum("ij,ij->i", before, after) > 0) & (new > 1e-6 * size.max())).all())
+
+
+def simplify(P, F, *, base: int = 4) -> tuple:
+    """Rounds of independent half-edge collapses of the closed genus-0 mesh ``(P, F)`` (module docstring) down to
+    ``base`` vertices or until none is allowed. Returns ``(base_faces, rounds)``: each round
+    ``(removed, target, faces_before)``, coarsest last.
+
+    >>> from datasets_synthetic.closed_meshes import sphere_mesh
+    >>> m = sphere_mesh(level=2)
+    >>> F0, rounds = simplify(m.points, m.faces.reshape(-1, 4)[:, 1:])
+    >>> len(np.unique(F0)), len(F0)  # a tetrahedron
+    (4, 4)
+    """
+    P = np.asarray(P, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    n = len(P)
+    rounds = []
+    while True:
+        alive = np.unique(F)
+        if alive.size <= base:
+            break
+        A = _adjacency(F, n)
+        deg = np.diff(A.indptr)
+        v, u, length = _candidate_edges(P, F, A, deg)
+        if v.size == 0:
+            break
+        order = np.lexsort((u, length))  # shortest first (ties by index: the same on every machine)
+        v, u = v[order], u[order]
+        blocked = np.zeros(n, dtype=bool)
+        removed, target = [], []
+        budget = alive.size - base
+        incident = _incidence(F, n)
+        for vi, ui in zip(v.tolist(), u.tolist()):
+            if blocked[vi]:
+                continue
+            ring = A.indices[A.indptr[vi]: A.indptr[vi + 1]]
+            if blocked[ring].any() or not _keeps_shape(P, F[incident.indices[incident.indptr[vi]: incident.indptr[vi + 1]]],
+                                                        vi, ui):
+                continue
+            removed.append(vi)
+            target.append(ui)
+            blocked[vi] = True
+            blocked[ring] = True
+            if len(removed) == budget:
+                break
+        removed, target = np.asarray(removed, dtype=np.int64), np.asarray(target, dtype=np.int64)
+        rounds.append((removed, target, F))
+        to = np.arange(n)
+        to[removed] = target
+        G = to[F]
+        F = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 2] != G[:, 0])]
+    return F, rounds
+
+
+def _tetrahedron(F):
+    """Unit vectors of a regular tetrahedron for the four vertices of ``F``, every triangle outward."""
+    ids = np.unique(F)
+    X = np.zeros((int(F.max()) + 1, 3))
+    X[ids] = _unit(np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]]))
+    if (_det(X, F) < 0).all():
+        X[ids[[0, 1]]] = X[ids[[1, 0]]]
+    return X
+
+
+def _insert(X, removed, target, F):
+    """Place each removed vertex near its target with all its triangles of ``F`` outward (module docstring);
+    returns the vertices it could not place (empty when all are placed)."""
+    mine = np.isin(F, removed)
+    rows = np.flatnonzero(mine.any(axis=1))
+    T = F[rows]
+    k = np.argmax(np.isin(T, removed), axis=1)
+    T = np.stack([T[np.arange(len(T)), k], T[np.arange(len(T)), (k + 1) % 3], T[np.arange(len(T)), (k + 2) % 3]],
+                 axis=1)  # (v, a, b), same orientation
+    slot = np.full(int(F.max()) + 1, -1)
+    slot[removed] = np.arange(removed.size)
+    owner = slot[T[:, 0]]
+    u = target[owner]
+    # the two triangles on the collapsed edge: (v, u, x) and (v, y, u); the corner at u spans x..y
+    x = np.zeros(removed.size, dtype=np.int64)
+    y = np.zeros(removed.size, dtype=np.int64)
+    first = T[:, 1] == u
+    x[owner[first]] = T[first, 2]
+    second = T[:, 2] == u
+    y[owner[second]] = T[second, 1]
+    Xu = X[target]
+    tx, ty = _unit(X[x] - Xu), _unit(X[y] - Xu)
+    ring_sum = np.zeros((removed.size, 3))
+    np.add.at(ring_sum, owner, X[T[:, 1]])
+    directions = [_unit(tx + ty), -_unit(tx + ty), _unit(ring_sum) - Xu]
+    placed = np.zeros(removed.size, dtype=bool)
+    for d in directions:
+        for s in 0.5 ** np.arange(1, 52):
+            todo = ~placed
+            if not todo.any():
+                return removed[:0]
+            X[removed[todo]] = _unit(Xu[todo] + s * np.nan_to_num(d[todo]))
+            bad = np.zeros(removed.size, dtype=bool)
+            bad[owner[~(_det(X, T) > DET_BOUND)]] = True
+            placed |= todo & ~bad
+    return removed[~placed]
+
+
+def _center_inserted(X, removed, F, iterations: int = 60):
+    """Move each inserted vertex to the analytic centre of its ring's kernel on the sphere: the maximum of
+    ``sum log det[x, a, b]`` over its triangles ``(x, a, b)`` (the region where all of them are outward is the
+    intersection of the hemispheres ``x . (a x b) > 0``). Damped Newton steps in the tangent plane, each halved
+    until every triangle stays outward and the sum grows; a vertex placed a hair from its target moves out to
+    where its triangles are as far from flat as its ring allows."""
+    mine = np.isin(F, removed)
+    T = F[mine.any(axis=1)]
+    k = np.argmax(np.isin(T, removed), axis=1)
+    r = np.arange(len(T))
+    T = np.stack([T[r, k], T[r, (k + 1) % 3], T[r, (k + 2) % 3]], axis=1)
+    slot = np.full(int(F.max()) + 1, -1)
+    slot[removed] = np.arange(removed.size)
+    owner = slot[T[:, 0]]
+    C = np.cross(X[T[:, 1]], X[T[:, 2]])  # det[x, a, b] = x . (a x b)
+    m = removed.size
+
+    def barrier(x):
+        d = np.einsum("ij,ij->i", C, x[owner])
+        phi = np.zeros(m)
+        bad = np.zeros(m, dtype=bool)
+        bad[owner[~(d > DET_BOUND)]] = True
+        np.add.at(phi, owner, np.log(np.where(d > 0, d, 1.0)))
+        return np.where(bad, -np.inf, phi), d
+
+    x = X[removed].copy()
+    phi, d = barrier(x)
+    for _ in range(iterations):
+        g = np.zeros((m, 3))
+        np.add.at(g, owner, C / d[:, None])
+        H = np.zeros((m, 3, 3))
+        np.add.at(H, owner, np.einsum("fi,fj->fij", C, C) / (d * d)[:, None, None])
+        # tangent basis at x
+        e1 = np.cross(x, np.where(np.abs(x[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
+        e1 = _unit(e1)
+        e2 = np.cross(x, e1)
+        E = np.stack([e1, e2], axis=2)  # (m, 3, 2)
+        gt = np.einsum("mik,mi->mk", E, g)
+        Ht = np.einsum("mik,mij,mjl->mkl", E, H, E) + 1e-300 * np.eye(2)
+        step = np.einsum("mik,mk->mi", E, np.linalg.solve(Ht, gt[..., None])[..., 0])
+        if np.abs(gt).max() == 0:
+            break
+        lam = np.ones(m)
+        moving = np.ones(m, dtype=bool)
+        for _ in range(40):
+            y = np.where(moving[:, None], _unit(x + lam[:, None] * step), x)
+            phi_new, d_new = barrier(y)
+            worse = moving & ~(phi_new > phi)
+            if not worse.any():
+                break
+            lam[worse] *= 0.5
+            moving &= lam > 1e-12
+        better = moving & (phi_new > phi)
+        x[better] = y[better]
+        phi = np.where(better, phi_new, phi)
+        d = np.einsum("ij,ij->i", C, x[owner])
+        if not better.any():
+            break
+    X[removed] = x
+
+
+def hierarchical_sphere(P, F, *, relax_steps: int = 25, progress: bool = False) -> tuple:
+    """One-to-one unit vectors ``X`` (V, 3) for the closed genus-0 mesh ``(P, F)`` built coarse to fine (module
+    docstring), and a dict of ``levels``, ``base_vertices`` and ``seconds``.
+
+    >>> from datasets_synthetic.closed_meshes import stretched_blob
+    >>> m = stretched_blob(level=2)
+    >>> F = m.faces.reshape(-1, 4)[:, 1:]
+    >>> X, info = hierarchical_sphere(m.points, F)
+    >>> int((_det(X, F) <= DET_BOUND).sum()), info["base_vertices"]
+    (0, 4)
+    """
+    from .sphere import _relax, _start_vertices, _tutte_sphere
+    from .stretch import StretchEnergy
+
+    t0 = time.perf_counter()
+    P = np.asarray(P, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    base, rounds = simplify(P, F)
+    nbase = np.unique(base).size
+    if nbase == 4:
+        X = _tetrahedron(base)
+        X = np.vstack([X, np.zeros((len(P) - len(X), 3))]) if len(X) < len(P) else X
+    else:  # no collapse allowed before a tetrahedron: the Tutte start of the base mesh
+        ids = np.unique(base)
+        local = np.searchsorted(ids, base)
+        v = next(_start_vertices(local, np.ones(ids.size)), None)
+        if v is None:
+            raise RuntimeError(f"the simplified mesh ({ids.size} vertices) has no vertex to cut it open at.")
+        X = np.zeros((len(P), 3))
+        X[ids] = _tutte_sphere(P[ids], local, np.ones(ids.size), v)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(rounds), desc="coarse to fine", unit="level")
+    relaxed_at = nbase
+    for removed, target, faces in reversed(rounds):
+        lost = _insert(X, removed, target, faces)
+        if lost.size:
+            raise RuntimeError(f"coarse to fine: {lost.size} vertices (e.g. {int(lost[0])}) found no place with "
+                               "all their triangles outward.")
+        _center_inserted(X, removed, faces)
+        ids = np.unique(faces)
+        if ids.size <= RELAX_ALWAYS or ids.size >= GROWTH * relaxed_at or ids.size == len(P):
+            local = np.searchsorted(ids, faces)
+            Y, _ = _relax(X[ids], StretchEnergy(P[ids], local), relax_steps, False, 1e-3)
+            X[ids] = Y
+            relaxed_at = ids.size
+        if bar is not None:
+            bar.update(1)
+    if bar is not None:
+        bar.close()
+    return X, {"levels": len(rounds), "base_vertices": nbase, "seconds": time.perf_counter() - t0}
