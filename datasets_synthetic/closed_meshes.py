@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "star_blob_radius", "star_blob_normals", "stretched_blob",
-           "bent_blob", "torus_mesh", "open_cup", "two_spheres", "nonmanifold_edge"]
+           "bent_blob", "legged_blob", "torus_mesh", "open_cup", "two_spheres", "nonmanifold_edge"]
 
 
 def _poly(points, tri):
@@ -132,6 +132,23 @@ def stretched_blob(level: int = 3):
     """
     P, F = _icosphere(level)
     return _poly(P * star_blob_radius(P, 0.25)[:, None] * [4.0, 1.0, 1.0], F)
+
+
+def legged_blob(level: int = 4, length: float = 15.0, width: float = 0.2):
+    """A unit sphere with six thin legs (along +-x, +-y, +-z) ``length`` long, each over a cap of angular
+    radius ``width``: radius ``1 + length sqrt(max(0, 1 - angle / width))`` (a radial graph, so closed and
+    embedded). A harmonic (Tutte) embedding shrinks such legs below double precision (the scans with legs and
+    ears of real files), which a spherical parametrization must survive.
+
+    >>> m = legged_blob(level=2)
+    >>> m.n_points, round(float(m.bounds[1]), 6)
+    (162, 16.0)
+    """
+    P, F = _icosphere(level)
+    X = P / np.linalg.norm(P, axis=1, keepdims=True)
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    angle = np.arccos(np.clip(X @ axes.T, -1.0, 1.0)).min(axis=1)
+    return _poly(X * (1.0 + length * np.sqrt(np.clip(1.0 - angle / width, 0.0, 1.0)))[:, None], F)
 
 
 def bent_blob(level: int = 3, half_length: float = 2.4, r: float = 0.45):

@@ -111,7 +111,8 @@ def test_the_stretch_reported_is_sanders_and_finite(make):
     # Cauchy-Schwarz: the normalized stretch is at least 1; the relaxation lowers it
     assert 1.0 - 1e-12 <= st["l2"] <= st["l2_start"]
     assert st["l2_max"] >= st["l2_p95"] and st["area_ratio_max"] >= st["area_ratio_p95"] >= 1.0
-    assert set(smap.timings) == {"validate", "tutte", "mobius", "relax", "check", "total"}
+    assert set(smap.timings) == {"validate", "tutte", "mobius", "hierarchy", "relax", "check", "total"}
+    assert smap.start == "tutte" and smap.timings["hierarchy"] == 0.0
 
 
 def test_long_shapes_have_more_stretch_than_round_ones():
