@@ -233,6 +233,7 @@ def _center_inserted(X, removed, F, iterations: int = 60):
 
     x = X[removed].copy()
     phi, d = barrier(x)
+    active = np.ones(m, dtype=bool)
     for _ in range(iterations):
         g = np.zeros((m, 3))
         np.add.at(g, owner, C / d[:, None])
@@ -245,11 +246,14 @@ def _center_inserted(X, removed, F, iterations: int = 60):
         E = np.stack([e1, e2], axis=2)  # (m, 3, 2)
         gt = np.einsum("mik,mi->mk", E, g)
         Ht = np.einsum("mik,mij,mjl->mkl", E, H, E) + 1e-300 * np.eye(2)
-        step = np.einsum("mik,mk->mi", E, np.linalg.solve(Ht, gt[..., None])[..., 0])
-        if np.abs(gt).max() == 0:
+        newton = np.linalg.solve(Ht, gt[..., None])[..., 0]
+        step = np.einsum("mik,mk->mi", E, newton)
+        # the Newton decrement squared, g . H^-1 g: the barrier's rise still to come is about half of it; below
+        # 1e-3 a vertex is at its centre for our purpose (the relaxation moves it on anyway)
+        moving = active & (np.einsum("mk,mk->m", gt, newton) > 1e-3)
+        if not moving.any():
             break
         lam = np.ones(m)
-        moving = np.ones(m, dtype=bool)
         for _ in range(40):
             y = np.where(moving[:, None], _unit(x + lam[:, None] * step), x)
             phi_new, d_new = barrier(y)
@@ -262,14 +266,16 @@ def _center_inserted(X, removed, F, iterations: int = 60):
         x[better] = y[better]
         phi = np.where(better, phi_new, phi)
         d = np.einsum("ij,ij->i", C, x[owner])
-        if not better.any():
+        active &= better  # no step raised it: done
+        if not active.any():
             break
     X[removed] = x
 
 
-def hierarchical_sphere(P, F, *, relax_steps: int = 25, progress: bool = False) -> tuple:
+def hierarchical_sphere(P, F, *, relax_steps: int = 10, progress: bool = False) -> tuple:
     """One-to-one unit vectors ``X`` (V, 3) for the closed genus-0 mesh ``(P, F)`` built coarse to fine (module
-    docstring), and a dict of ``levels``, ``base_vertices`` and ``seconds``.
+    docstring), and a dict of ``levels``, ``base_vertices`` and ``seconds``. The finest level is not relaxed
+    here: :func:`.sphere.spherical_parametrization` relaxes the whole mesh next.
 
     >>> from datasets_synthetic.closed_meshes import stretched_blob
     >>> m = stretched_blob(level=2)
@@ -310,7 +316,7 @@ def hierarchical_sphere(P, F, *, relax_steps: int = 25, progress: bool = False) 
                                "all their triangles outward.")
         _center_inserted(X, removed, faces)
         ids = np.unique(faces)
-        if ids.size <= RELAX_ALWAYS or ids.size >= GROWTH * relaxed_at or ids.size == len(P):
+        if ids.size < len(P) and (ids.size <= RELAX_ALWAYS or ids.size >= GROWTH * relaxed_at):
             local = np.searchsorted(ids, faces)
             Y, _ = _relax(X[ids], StretchEnergy(P[ids], local), relax_steps, False, 1e-3)
             X[ids] = Y
