@@ -69,7 +69,7 @@ def bench_read_3dm(data: Path, repeats: int = 3) -> dict:
             rows.append({"file": f.name, "MB": f.stat().st_size / 1e6, "error": r.stderr.strip().splitlines()[-1]})
             continue
         rows.append({"file": f.name, "MB": f.stat().st_size / 1e6, **json.loads(r.stdout.strip().splitlines()[-1])})
-    return {"data": str(data), "repeats": repeats, "cpus": os.cpu_count(), "python": platform.python_version(),
+    return {"data": os.path.relpath(data, Path(__file__).resolve().parents[1]), "repeats": repeats, "cpus": os.cpu_count(), "python": platform.python_version(),
             "rows": rows}
 
 

@@ -154,7 +154,7 @@ def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample
     (True, True)
     """
     from scipy.interpolate import NdBSpline
-    from scipy.sparse import diags, vstack
+    from scipy.sparse import diags
     from scipy.sparse.linalg import cg
 
     if not fairness >= 0.0:

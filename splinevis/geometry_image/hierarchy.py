@@ -16,7 +16,7 @@
    tend to ``u``'s old ones, which were outward, and the two new ones open inside the corner. Each inserted
    vertex then moves to the analytic centre of the region where all its triangles are outward (its ring's
    kernel, an intersection of hemispheres), so no triangle is left a hair from flat; and the stretch of the
-   whole level is relaxed after every round while it is small, then whenever it has grown by a quarter (:func:`.sphere._relax`, which never flips
+   whole level is relaxed after every round while it is small, then whenever it has grown by a quarter (:func:`.relax._relax`, which never flips
    a triangle). Every level is so one-to-one by construction; the final check of :mod:`.sphere` confirms it.
 
 Why coarse to fine: a Tutte (harmonic) embedding shrinks a protrusion exponentially along its length: the feet
@@ -33,7 +33,8 @@ import time
 
 import numpy as np
 
-from .sphere import DET_BOUND
+from .relax import DET_BOUND, _det, _relax, _unit
+from .tutte import _start_vertices, _tutte_sphere
 
 __all__ = ["simplify", "hierarchical_sphere", "RELAX_ALWAYS", "GROWTH"]
 
@@ -41,14 +42,6 @@ __all__ = ["simplify", "hierarchical_sphere", "RELAX_ALWAYS", "GROWTH"]
 #: leave the next vertex no room); larger ones when the vertex count has grown by :data:`GROWTH`.
 RELAX_ALWAYS = 5000
 GROWTH = 1.25
-
-
-def _unit(x):
-    return x / np.linalg.norm(x, axis=-1, keepdims=True)
-
-
-def _det(X, F):
-    return np.einsum("ij,ij->i", X[F[:, 0]], np.cross(X[F[:, 1]], X[F[:, 2]]))
 
 
 def _adjacency(F, n):
@@ -284,7 +277,6 @@ def hierarchical_sphere(P, F, *, relax_steps: int = 10, progress: bool = False) 
     >>> int((_det(X, F) <= DET_BOUND).sum()), info["base_vertices"]
     (0, 4)
     """
-    from .sphere import _relax, _start_vertices, _tutte_sphere
     from .stretch import StretchEnergy
 
     t0 = time.perf_counter()

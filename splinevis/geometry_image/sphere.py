@@ -46,7 +46,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .mobius import center_on_sphere
+from .relax import DET_BOUND, _det, _relax, _unit
 from .stretch import StretchEnergy
+from .tutte import _start_vertices, _tutte_sphere
 from .validate import check_genus0
 
 __all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE", "DET_BOUND"]
@@ -54,11 +56,6 @@ __all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_point
 #: Largest accepted ``|sum of spherical triangle areas - 4 pi|`` (see the module docstring).
 AREA_TOLERANCE = 1e-6
 
-#: Smallest ``det[a, b, c]`` of unit vectors that counts as outward: the rounding error of ``a . (b x c)`` is at
-#: most ``5 u sum_i |a_i| (|b_j c_k| + |b_k c_j|) <= 5 sqrt(2) u`` (two products and a difference per component
-#: of the cross product, three products and two sums in the dot product; ``u`` the unit roundoff, first order,
-#: Cauchy-Schwarz), so a computed det above ``8 u`` is positive in exact arithmetic too.
-DET_BOUND = 8 * np.finfo(np.float64).eps / 2
 
 
 @dataclass(frozen=True)
@@ -109,211 +106,12 @@ def _frozen(a, dtype):
     return a
 
 
-def _unit(x):
-    return x / np.linalg.norm(x, axis=-1, keepdims=True)
-
-
-def _det(X, F):
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    return np.einsum("ij,ij->i", a, np.cross(b, c))
-
-
 def _spherical_area_sum(X, F):
     """Sum of the signed areas of the spherical triangles [VanOosterom1983]: ``tan(A / 2) = det[a, b, c] / (1 + a.b + b.c + c.a)``."""
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
     num = np.einsum("ij,ij->i", a, np.cross(b, c))
     den = 1.0 + np.einsum("ij,ij->i", a, b) + np.einsum("ij,ij->i", b, c) + np.einsum("ij,ij->i", c, a)
     return float(2.0 * np.arctan2(num, den).sum())
-
-
-# ------------------------------------------------------------------------------------- stage 1: the start
-def _mean_value_weights(P, F):
-    """Sparse ``(V, V)`` mean-value weights ``w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|`` (a, b the angles at
-    ``i`` beside edge ``ij``); ``tan(t/2) = |u x w| / (|u||w| + u.w)`` is positive for every proper triangle."""
-    from scipy.sparse import coo_matrix
-
-    rows, cols, vals = [], [], []
-    for k in range(3):
-        i, j, l = F[:, k], F[:, (k + 1) % 3], F[:, (k + 2) % 3]
-        u, w = P[j] - P[i], P[l] - P[i]
-        nu, nw = np.linalg.norm(u, axis=1), np.linalg.norm(w, axis=1)
-        half = np.linalg.norm(np.cross(u, w), axis=1) / (nu * nw + np.einsum("ij,ij->i", u, w))
-        rows += [i, i]
-        cols += [j, l]
-        vals += [half / nu, half / nw]
-    n = len(P)
-    return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)).tocsr()
-
-
-def _ring(F, v):
-    """The ring of vertex ``v`` as an ordered cycle (each star triangle ``(v, a, b)`` gives ``a -> b``)."""
-    star = F[(F == v).any(axis=1)]
-    star = np.array([np.roll(t, -int(np.flatnonzero(t == v)[0])) for t in star])
-    nxt = dict(zip(star[:, 1].tolist(), star[:, 2].tolist()))
-    ring = [int(star[0, 1])]
-    while len(ring) < len(star):
-        ring.append(nxt[ring[-1]])
-    return np.array(ring, dtype=np.int64)
-
-
-def _start_vertices(F, mass, count=5, search=500):
-    """Up to ``count`` vertices to cut out (of the ``search`` of largest area, largest first), each with a
-    chordless ring: no edge joins two ring vertices that are not ring neighbours. A chord ``ac`` of the ring
-    would make triangles like ``abc`` with all three vertices on the circle, whose flat triangles on a small
-    circle of the sphere face the wrong way."""
-    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    found = 0
-    for v in np.argsort(-mass, kind="stable")[:search]:
-        ring = _ring(F, int(v))
-        if np.isin(edges, ring).all(axis=1).sum() == 2 * len(ring):  # each edge is in two triangles
-            yield int(v)
-            found += 1
-            if found == count:
-                return
-
-
-def _tutte_sphere(P, F, mass, v):
-    """Stage 1: the Tutte embedding of the mesh minus the star of ``v``, then the inverse stereographic
-    projection (``v`` at the north pole)."""
-    from scipy.sparse import diags
-    from scipy.sparse.linalg import spsolve
-
-    n = len(P)
-    ring = _ring(F, v)
-    arc = np.linalg.norm(P[np.roll(ring, -1)] - P[ring], axis=1)
-    angle = 2 * np.pi * np.concatenate([[0.0], np.cumsum(arc)[:-1]]) / arc.sum()
-    W = _mean_value_weights(P, F)
-    L = (diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
-    inner = np.ones(n, dtype=bool)
-    inner[ring] = False
-    inner[v] = False
-    I = np.flatnonzero(inner)
-    u = np.zeros((n, 2))
-    u[ring] = np.column_stack([np.cos(angle), np.sin(angle)])
-    rhs = -(L[I][:, ring] @ u[ring])
-    u[I] = spsolve(L[I][:, I].tocsc(), rhs)
-    disk = ~(F == v).any(axis=1)
-    e1, e2 = u[F[disk, 1]] - u[F[disk, 0]], u[F[disk, 2]] - u[F[disk, 0]]
-    if (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum() < 0:
-        u[:, 1] = -u[:, 1]
-    # scale so that half the surface lies inside the unit circle: the southern hemisphere
-    r = np.linalg.norm(u, axis=1)
-    order = np.argsort(r[inner])
-    half = np.searchsorted(np.cumsum(mass[inner][order]), 0.5 * mass[inner].sum())
-    u /= max(r[inner][order][min(half, order.size - 1)], 1e-300)
-    r2 = (u * u).sum(axis=1)
-    # inverse stereographic projection from the north pole, mirrored in y: counter-clockwise in the plane is
-    # outward on the sphere
-    X = np.column_stack([2 * u[:, 0], -2 * u[:, 1], r2 - 1.0]) / (r2 + 1.0)[:, None]
-    X[v] = [0.0, 0.0, 1.0]
-    return _unit(X)
-
-
-# ------------------------------------------------------------------------- stage 3: stretch relaxation
-def _safe_step(X, d, lam, F, incident):
-    """``unit(X + lam d)`` with per-vertex steps ``lam`` (changed in place) such that no triangle is flipped: the
-    vertices of flipped triangles halve their step, then only the triangles around them are checked again. A
-    vertex halved 40 times stops (step 0); a triangle whose three vertices stop is as in ``X``, unflipped, so
-    this ends."""
-    Y = _unit(X + lam[:, None] * d)
-    halved = np.zeros(len(X), dtype=np.int64)
-    faces = np.arange(len(F))
-    while True:
-        bad = faces[~(_det(Y, F[faces]) > DET_BOUND)]
-        if not bad.size:
-            return Y
-        moved = np.unique(F[bad])
-        halved[moved] += 1
-        lam[moved] = np.where(halved[moved] > 40, 0.0, 0.5 * lam[moved])
-        Y[moved] = _unit(X[moved] + lam[moved, None] * d[moved])
-        faces = np.unique(incident[moved].indices)
-
-
-def _tangent(v, X):
-    return v - np.einsum("ij,ij->i", v, X)[:, None] * X
-
-
-def _relax(X, S, iterations, progress, tol, memory=8):
-    """Stage 3: descent of the stretch energy on the sphere, never flipping a triangle: L-BFGS directions
-    [Nocedal1980] on the tangent planes, with the
-    preconditioner as the initial inverse Hessian. A step that does not lower the energy enough (Armijo) is
-    halved; where it would flip a triangle it is halved for that triangle's vertices (:func:`_safe_step`)."""
-    from scipy.sparse.linalg import splu
-
-    F = S.F
-    incident = (S.gather @ _corner_face(len(F))).tocsr()  # vertex -> its triangles
-    E, g, sph = S.gradient(X)
-    g = _tangent(g, X)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=iterations, desc="stretch relaxation", unit="step")
-    steps, history, energies = 0, [], [E]
-    for _ in range(iterations):
-        if steps % 4 == 0:  # the preconditioner changes slowly: factor it every 4th step
-            lu = splu(S.preconditioner(sph))
-        # two-loop recursion
-        q = g.copy()
-        alphas = []
-        for s_k, y_k, rho in reversed(history):
-            a = rho * np.vdot(s_k, q)
-            q -= a * y_k
-            alphas.append(a)
-        r = lu.solve(q)
-        if history:
-            s_k, y_k, _ = history[-1]
-            r *= np.vdot(s_k, y_k) / max(np.vdot(y_k, lu.solve(y_k)), 1e-300)
-        for (s_k, y_k, rho), a in zip(history, reversed(alphas)):
-            r += (a - rho * np.vdot(y_k, r)) * s_k
-        d = -_tangent(r, X)
-        slope = float(np.vdot(g, d))
-        if slope >= 0 or not np.isfinite(slope):
-            history = []
-            d = -_tangent(lu.solve(g), X)
-            slope = float(np.vdot(g, d))
-            if slope >= 0:
-                break
-        if history:
-            step = 1.0
-        else:  # no curvature pairs yet: minimize the quadratic model along d (its curvature from a small step)
-            eps = 1e-4 / max(np.abs(d).max(), 1e-300)
-            curv = float(np.vdot(_tangent(S.gradient(_unit(X + eps * d))[1], X) - g, d)) / eps
-            step = -slope / curv if curv > 0 else 1.0
-        step = min(step, 0.5 / np.linalg.norm(d, axis=1).max())  # no vertex moves more than half a radian
-        accepted = False
-        for _ in range(40):
-            Y = _safe_step(X, d, np.full(len(X), step), F, incident)
-            E_new = S.energy(Y)
-            if E_new <= E + 1e-4 * step * slope:
-                accepted = True
-                break
-            step *= 0.5
-        if bar is not None:
-            bar.update(1)
-        if not accepted:
-            break
-        steps += 1
-        energies.append(E_new)
-        E, g_new, sph = S.gradient(Y)
-        g_new = _tangent(g_new, Y)
-        s_k, y_k = Y - X, g_new - _tangent(g, Y)
-        sy = np.vdot(s_k, y_k)
-        if sy > 1e-12 * np.vdot(s_k, s_k) ** 0.5 * np.vdot(y_k, y_k) ** 0.5:
-            history = (history + [(s_k, y_k, 1.0 / sy)])[-memory:]
-        X, g = Y, g_new
-        if len(energies) > 5 and energies[-6] - E < 5 * tol * E:  # under tol a step over the last 5 steps
-            break
-    if bar is not None:
-        bar.close()
-    return X, steps
-
-
-def _corner_face(F):
-    """``(3 F, F)`` sparse: corner ``3 t + k`` belongs to triangle ``t``."""
-    from scipy.sparse import coo_matrix
-
-    return coo_matrix((np.ones(3 * F), (np.arange(3 * F), np.repeat(np.arange(F), 3))), shape=(3 * F, F))
 
 
 # --------------------------------------------------------------------------------------------- the pipeline
