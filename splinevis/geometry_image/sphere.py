@@ -14,8 +14,8 @@ It is built in three stages, each of which keeps it one-to-one:
    triangles (circular-arc triangles) and of the star tile the sphere once, and the flat triangles on the same
    vertices do too unless a triangle is large against the arcs' bulge, which the check below would catch.
    A harmonic embedding shrinks protrusions exponentially along their length: on a four-legged scan the feet
-   came out flat below double precision for every cut. Where no cut gives a one-to-one start, the
-   coarse-to-fine start of :mod:`.hierarchy` replaces stages 1 and 2.
+   came out flat below double precision for every cut, and on the armadillo so squeezed (stretch 1993) that the
+   relaxation could not recover. There the coarse-to-fine start of :mod:`.hierarchy` replaces stages 1 and 2.
 2. **Möbius centering** (:mod:`.mobius`): a conformal start crowds most of the surface into a small part of the
    sphere; the Möbius transformation that puts the area-weighted centroid of the vertex images at the origin
    spreads it out, keeping the map conformal and one-to-one.
@@ -51,7 +51,13 @@ from .stretch import StretchEnergy
 from .tutte import _start_vertices, _tutte_sphere
 from .validate import check_genus0
 
-__all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE", "DET_BOUND"]
+__all__ = ["SphericalMap", "spherical_parametrization", "locate", "surface_points", "AREA_TOLERANCE", "DET_BOUND",
+           "SQUEEZED"]
+
+#: Stretch of a Tutte start above which ``start="auto"`` builds the coarse-to-fine start instead (a squeeze the
+#: relaxation does not undo: measured 24 -> 1.27 on the elephant, 1993 -> 87 on the armadillo; see
+#: :func:`spherical_parametrization`).
+SQUEEZED = 100.0
 
 #: Largest accepted ``|sum of spherical triangle areas - 4 pi|`` (see the module docstring).
 AREA_TOLERANCE = 1e-6
@@ -135,9 +141,12 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     progress : bool
         Show a tqdm progress bar over the relaxation's steps.
     start : {"auto", "tutte", "hierarchy"}
-        The one-to-one start: the Tutte embedding (stage 1), the coarse-to-fine construction of
-        :mod:`.hierarchy` (scans whose protrusions a Tutte embedding squeezes below double precision), or
-        ``"auto"``: Tutte, and the coarse-to-fine start where no Tutte start is one-to-one.
+        The one-to-one start: the Tutte embedding with Moebius centering (``"tutte"``: stages 1 and 2), the
+        coarse-to-fine construction of :mod:`.hierarchy` (``"hierarchy"``), or ``"auto"``: Tutte, replaced by
+        coarse to fine where no Tutte start is one-to-one or its stretch exceeds :data:`SQUEEZED`. The Tutte
+        start squeezes protrusions, and past some point the relaxation cannot undo it: the armadillo's Tutte
+        start has stretch 1993 and relaxes to 87, its coarse-to-fine start 2.68 and relaxes to 2.07 (the
+        elephant's Tutte start, 24, relaxes to 1.27 as well as its coarse-to-fine one).
 
     ``stretch`` holds the L2 stretch of the map from the sphere to the mesh, normalized so that 1 is the optimum
     (module docstring): ``"l2"`` over the mesh (at least 1); ``"l2_max"`` and ``"l2_p95"`` over its triangles,
@@ -172,8 +181,9 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     mass = igl.massmatrix(P, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
     timings["tutte"] = timings["mobius"] = timings["hierarchy"] = 0.0
     failure = f"{name}: no vertex has a chordless ring to cut the mesh open at."
-    X = None
-    for v in (_start_vertices(F, mass) if start != "hierarchy" else ()):  # next candidate if not one-to-one
+    X, method = None, "tutte"
+    S = StretchEnergy(P, F)
+    for v in (_start_vertices(F, mass) if start != "hierarchy" else ()):  # the next one if not one-to-one
         t = time.perf_counter()
         Y = _tutte_sphere(P, F, mass, v)
         timings["tutte"] += time.perf_counter() - t
@@ -182,23 +192,27 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
         timings["mobius"] += time.perf_counter() - t
         try:
             _check_one_to_one(Y, F, name, f"the Tutte start cut at vertex {v}")
-            X, method = Y, "tutte"
+            X = Y
             break
         except RuntimeError as err:
             failure = str(err)
+    squeezed = X is not None and start == "auto" and S.report(X)["l2"] > SQUEEZED
     if X is None and start == "tutte":
-        raise RuntimeError(failure + " (start='auto' tries the coarse-to-fine start then)")
-    if X is None:
+        raise RuntimeError(failure + " (start='auto' or 'hierarchy' builds the coarse-to-fine start)")
+    if X is None or squeezed:
         from .hierarchy import hierarchical_sphere
 
         t = time.perf_counter()
-        X, info = hierarchical_sphere(P, F, progress=bool(progress))
+        try:
+            Y, info = hierarchical_sphere(P, F, progress=bool(progress))
+            _check_one_to_one(Y, F, name, "the coarse-to-fine start")
+            X, method = Y, f"coarse to fine ({info['levels']} levels)"
+        except RuntimeError as err:
+            if X is None:
+                raise RuntimeError(f"{failure}; and {err}") from err
         timings["hierarchy"] = time.perf_counter() - t
-        _check_one_to_one(X, F, name, "the coarse-to-fine start")
-        method = f"coarse to fine ({info['levels']} levels)"
 
     t = time.perf_counter()
-    S = StretchEnergy(P, F)
     l2_start = S.report(X)["l2"]
     X, steps = _relax(X, S, int(iterations), bool(progress), float(tol))
     timings["relax"] = time.perf_counter() - t
