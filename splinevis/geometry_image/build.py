@@ -24,7 +24,8 @@ from .fit import fit_geometry_image
 from .measure import surface_distance
 from .model import GeometryImage
 
-__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "FOLDED_WARNING"]
+__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "FOLDED_WARNING",
+           "AUTO_SIZES", "AUTO_HAUSDORFF"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,7 +113,13 @@ def limit_mesh_arrays(image: GeometryImage, level: int):
     return sub.p.reshape(-1, 3), sub.n.reshape(-1, 3), grid_faces(M)
 
 
-def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversample: int = 4,
+#: Image sizes ``n="auto"`` tries, smallest first, and the Hausdorff distance (share of the diagonal) that
+#: ends the search: the first size whose limit surface is that close to the mesh.
+AUTO_SIZES = (33, 65, 129, 257)
+AUTO_HAUSDORFF = 0.005
+
+
+def geometry_image_from_mesh(mesh, n="auto", *, fairness: float = 0.1, oversample: int = 4,
                              name: str = "mesh", measure: bool = True, levels_finer: int = 2, progress: bool = False,
                              parametrization_options: dict | None = None, orientation="auto", sphere_map=None):
     """Build an ``n x n`` smooth geometry image of the closed genus-0 ``mesh`` (module docstring).
@@ -121,8 +128,11 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
     ----------
     mesh : pyvista.PolyData or str or path
         Triangles; a file name is read with ``pyvista.read``.
-    n : int
-        Samples per side, odd; ``2^k + 1`` for levels of detail down to the octahedron.
+    n : int or "auto"
+        Samples per side, odd; ``2^k + 1`` for levels of detail down to the octahedron. ``"auto"`` (default):
+        the first of :data:`AUTO_SIZES` whose limit surface is within :data:`AUTO_HAUSDORFF` of the diagonal of
+        the mesh (measured; ``distance["sizes_tried"]`` lists each size's distance), with a warning when the
+        largest is not.
     fairness : float
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
         leaves in the normals (measured in the geometry-image study) at a small cost in distance.
@@ -201,23 +211,35 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
             raise ValueError(f"orientation must be 'auto', None or a 3x3 rotation matrix, got {orientation!r}.")
     seconds["orient"] = time.perf_counter() - t0
 
-    t0 = time.perf_counter()
-    M = int(oversample) * (int(n) - 1) + 1
-    # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
-    samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R).reshape(M, M, 3)
-    seconds["sample"] = time.perf_counter() - t0
-
-    t0 = time.perf_counter()
-    fit = fit_geometry_image(None, n, fairness=fairness, oversample=oversample, samples=samples)
-    seconds["fit"] = time.perf_counter() - t0
-
-    distance, folded = {}, float("nan")
-    if measure:
+    sizes = AUTO_SIZES if isinstance(n, str) and n == "auto" else (int(n),)
+    if isinstance(n, str) and n != "auto":
+        raise ValueError(f"n must be 'auto' or an odd sample count, got {n!r}.")
+    measure = measure or len(sizes) > 1
+    tried = {}
+    for n in sizes:
         t0 = time.perf_counter()
-        P, N, F = limit_mesh_arrays(fit.image, levels_finer)
-        distance = surface_distance(P, F, smap.points, smap.faces)
-        folded = folded_fraction(P, N, F)
-        seconds["measure"] = time.perf_counter() - t0
+        M = int(oversample) * (int(n) - 1) + 1
+        # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
+        samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R).reshape(M, M, 3)
+        seconds["sample"] = seconds.get("sample", 0.0) + time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        fit = fit_geometry_image(None, n, fairness=fairness, oversample=oversample, samples=samples)
+        seconds["fit"] = seconds.get("fit", 0.0) + time.perf_counter() - t0
+
+        distance, folded = {}, float("nan")
+        if measure:
+            t0 = time.perf_counter()
+            P, N, F = limit_mesh_arrays(fit.image, levels_finer)
+            distance = surface_distance(P, F, smap.points, smap.faces)
+            folded = folded_fraction(P, N, F)
+            seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
+            tried[int(n)] = float(distance["hausdorff"])
+            if distance["hausdorff"] <= AUTO_HAUSDORFF:
+                break
+    if len(sizes) > 1:
+        distance["sizes_tried"] = tried
+    if measure:
         if folded > FOLDED_WARNING:
             import warnings
 
@@ -225,6 +247,12 @@ def geometry_image_from_mesh(mesh, n: int = 65, *, fairness: float = 0.1, oversa
                           f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
                           f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; a larger n "
                           "or fairness reduces the ripples.", stacklevel=2)
+        if len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
+            import warnings
+
+            warnings.warn(f"the geometry image of {name} stays {100 * distance['hausdorff']:.2g}% of the diagonal from the "
+                          f"mesh at n = {n}, the largest n='auto' tries (goal {100 * AUTO_HAUSDORFF:g}%): detail "
+                          "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=2)
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,

@@ -74,7 +74,7 @@ from .build import FOLDED_WARNING
 __all__ = ["JUDGE"]
 
 #: Option defaults: ``n`` and ``fairness`` of the build, ``level`` drawn, ``measure_level`` (None: ``level`` + 1).
-DEFAULTS = {"n": 65, "fairness": 0.1, "level": 3.0, "measure_level": None}
+DEFAULTS = {"n": "auto", "fairness": 0.1, "level": 3.0, "measure_level": None}
 
 #: Verdict thresholds (module docstring): distances in units of the input's bounding-box diagonal.
 THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FOLDED_WARNING, "reversed_fail": 1e-3}
@@ -219,7 +219,8 @@ def _read(path, options, findings) -> MeshData:
 def _build(data: MeshData, options, findings):
     from ..programs import get
 
-    n = int(_option(options, "n"))
+    n = _option(options, "n")
+    n = n if n == "auto" else int(n)
     return get("geometry_image").model_from(data.mesh, n, fairness=float(_option(options, "fairness")),
                                             name=data.name)
 

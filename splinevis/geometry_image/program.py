@@ -182,10 +182,11 @@ def displacement_map(image: GeometryImage, mesh, level: int, *, backend: str = "
     return np.einsum("ij,ij->i", C - p.reshape(-1, 3), n.reshape(-1, 3)).reshape(p.shape[:2])
 
 
-def model_from(data, n: int = 65, *, fairness: float = 0.1, **options) -> GeometryImage:
+def model_from(data, n="auto", *, fairness: float = 0.1, **options) -> GeometryImage:
     """A :class:`GeometryImage` from ``data``: itself, an ``(n, n, 3)`` control array, or a closed genus-0 mesh
     (pyvista PolyData or a file pyvista reads), built by :func:`.build.geometry_image_from_mesh` (call that for
-    the build report: times per stage, stretch, distance to the mesh).
+    the build report: times per stage, stretch, distance to the mesh); ``n="auto"`` picks the image size from the
+    mesh's detail.
 
     >>> from datasets_synthetic.closed_meshes import star_blob
     >>> model_from(star_blob(level=2), n=9).n
@@ -197,6 +198,7 @@ def model_from(data, n: int = 65, *, fairness: float = 0.1, **options) -> Geomet
         return GeometryImage(data, constrain=True)
     from .build import geometry_image_from_mesh
 
+    # n="auto" measures the distance anyway (and warns of folds and of detail it cannot resolve)
     image, _ = geometry_image_from_mesh(data, n, fairness=fairness, measure=False, **options)
     return image
 
