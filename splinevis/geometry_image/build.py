@@ -56,6 +56,9 @@ class BuildReport:
         Fraction of the measured limit mesh's triangles that face against the surface normals at their corners
         (:func:`folded_fraction`): ripples folding over where the parametrization undersamples the mesh; NaN
         when not measured.
+    repairs : tuple of str
+        What was done to the input to make it one closed triangle mesh (:func:`.repair.prepare_mesh`: welding,
+        triangulating, dropping unused points); each also a warning.
 
     Examples
     --------
@@ -76,6 +79,7 @@ class BuildReport:
     fit_rms: float = float("nan")
     folded: float = float("nan")
     orientation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    repairs: tuple = ()
 
 
 #: Above this fraction of folded limit triangles, :func:`geometry_image_from_mesh` warns.
@@ -173,13 +177,17 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness: float = 0.1, oversampl
     """
     import pyvista as pv
 
+    from .repair import prepare_mesh
     from .sphere import spherical_parametrization, surface_points
     from .validate import check_genus0
 
     if not isinstance(mesh, pv.DataSet):
         name = str(mesh) if name == "mesh" else name
-        mesh = pv.read(mesh)
-    mesh = mesh if isinstance(mesh, pv.PolyData) else mesh.extract_surface(algorithm=None)
+    mesh, repairs = prepare_mesh(mesh, name)
+    if repairs:
+        import warnings
+
+        warnings.warn(f"{name}: " + "; ".join(repairs), stacklevel=2)
     seconds = {}
     t0 = time.perf_counter()
     info = check_genus0(mesh, name)
@@ -256,5 +264,5 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness: float = 0.1, oversampl
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
-                         stretch, distance, fit.rms, folded, R)
+                         stretch, distance, fit.rms, folded, R, tuple(repairs))
     return fit.image, report

@@ -62,7 +62,6 @@ own; this module only reads, repairs with a report, and judges.
 from __future__ import annotations
 
 import math
-from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -82,7 +81,6 @@ THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FO
 #: The level whose limit points the reversed normals are counted on (module docstring).
 REVERSED_LEVEL = 2
 
-_POLYGON_NAMES = {3: "triangles", 4: "quads", 5: "pentagons", 6: "hexagons"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,116 +99,14 @@ def _option(options, key):
 # ---------------------------------------------------------------------------------------------------- read
 
 
-def _polygons_from_vtk(mesh):
-    """``(points, offsets, connectivity, ignored)`` of a pyvista PolyData's polygons (triangle strips split into
-    triangles); ``ignored`` counts its vertex and line cells."""
-    import pyvista as pv
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-
-    points = np.asarray(mesh.points, dtype=np.float64)
-    polys = mesh.GetPolys()
-    offsets = vtk_to_numpy(polys.GetOffsetsArray()).astype(np.int64)
-    conn = vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64)
-    if mesh.n_strips:
-        tri = pv.PolyData(mesh.points, strips=mesh.strips).triangulate()
-        t = np.asarray(tri.faces).reshape(-1, 4)[:, 1:].astype(np.int64)
-        offsets = np.concatenate([offsets, offsets[-1] + 3 * np.arange(1, len(t) + 1)])
-        conn = np.concatenate([conn, t.ravel()])
-    return points, offsets, conn, int(mesh.n_verts + mesh.n_lines)
-
-
-def _triangulate(points, offsets, conn):
-    """Triangles ``(T, 3)`` of polygons given as VTK offsets and connectivity (module docstring: fans whose
-    diagonals are not edges already, shortest first); also the polygon sizes."""
-    sizes = np.diff(offsets)
-    if sizes.size == 0:
-        return np.zeros((0, 3), np.int64), sizes
-    if (sizes == 3).all():
-        return conn.reshape(-1, 3), sizes
-    if (sizes < 3).any():
-        c = int(np.flatnonzero(sizes < 3)[0])
-        raise ValueError(f"polygon {c} has {int(sizes[c])} vertices; a face needs at least 3.")
-    edges = set()
-    for k in np.unique(sizes):
-        ring = conn[offsets[:-1][sizes == k][:, None] + np.arange(k)]
-        e = np.sort(np.stack([ring, np.roll(ring, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
-        edges.update(map(tuple, e.tolist()))
-    triangles = [conn[offsets[:-1][sizes == 3][:, None] + np.arange(3)]]
-    for k in np.unique(sizes[sizes > 3]).tolist():
-        ring = conn[offsets[:-1][sizes == k][:, None] + np.arange(k)]  # (polygons, k)
-        j = np.arange(2, k - 1)
-        # fan from corner s: diagonals (ring[s], ring[s + j]); its total diagonal length, (polygons, k)
-        length = np.stack([np.linalg.norm(points[ring[:, (s + j) % k]] - points[ring[:, [s]]], axis=-1).sum(axis=1)
-                           for s in range(k)], axis=1)
-        order = np.argsort(length, axis=1, kind="stable")
-        chosen = np.empty(len(ring), dtype=np.int64)
-        for i, (r, starts) in enumerate(zip(ring.tolist(), order.tolist())):
-            for s in starts:
-                diagonals = [(min(r[s], r[(s + jj) % k]), max(r[s], r[(s + jj) % k])) for jj in range(2, k - 1)]
-                if not any(d in edges for d in diagonals):
-                    break
-            else:
-                s = starts[0]  # every fan repeats an edge: the shortest (the topology check will say where)
-                diagonals = [(min(r[s], r[(s + jj) % k]), max(r[s], r[(s + jj) % k])) for jj in range(2, k - 1)]
-            edges.update(diagonals)
-            chosen[i] = s
-        fan = ring[np.arange(len(ring))[:, None], (chosen[:, None] + np.arange(k)) % k]  # rotated to start at s
-        triangles.append(np.stack([np.repeat(fan[:, :1], k - 2, axis=1), fan[:, 1:-1], fan[:, 2:]],
-                                  axis=-1).reshape(-1, 3))
-    return np.concatenate(triangles).astype(np.int64), sizes
-
-
 def _read(path, options, findings) -> MeshData:
-    """Read ``path`` and repair it into one triangle mesh, reporting each repair (module docstring)."""
-    import pyvista as pv
+    """Read ``path`` and repair it into one triangle mesh, each repair a WARN finding
+    (:func:`.repair.prepare_mesh`)."""
+    from .repair import prepare_mesh
 
-    path = Path(path)
-    if path.suffix.lower() == ".off":
-        import igl
-
-        V, F = igl.read_triangle_mesh(str(path))  # triangulates polygons itself (fans)
-        points = np.asarray(V, dtype=np.float64)
-        F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
-        offsets, conn, ignored = np.arange(0, 3 * len(F) + 1, 3, dtype=np.int64), F.ravel(), 0
-    else:
-        mesh = pv.read(path)
-        if not isinstance(mesh, pv.PolyData):
-            mesh = mesh.extract_surface(algorithm=None)
-        points, offsets, conn, ignored = _polygons_from_vtk(mesh)
-    if conn.size == 0:
-        raise ValueError(f"{path.name} has no faces ({len(points)} points): a point cloud or lines are not a surface.")
-    if ignored:
-        findings.append(Finding("WARN", f"ignored {ignored:,} point and line cells: only faces are drawn"))
-    if not np.isfinite(points).all():
-        raise ValueError(f"{path.name}: {int((~np.isfinite(points)).any(axis=1).sum())} points have a NaN or "
-                         "infinite coordinate.")
-
-    used = np.unique(conn)
-    if used.size < len(points):
-        findings.append(Finding("WARN", f"dropped {len(points) - used.size:,} of {len(points):,} points that no face "
-                                        "uses"))
-    # weld points at exactly the same position (+ 0.0 makes -0.0 and 0.0 one key), kept in the file's order: a file
-    # needing no repair keeps its vertex numbers, so the build is the one add_geometry_image makes of it (the
-    # spherical parametrization depends on the order)
-    _, first, inverse = np.unique(points[used] + 0.0, axis=0, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    unique = points[used][np.sort(first)]
-    remap = np.empty(len(points), dtype=np.int64)
-    remap[used] = rank[inverse.ravel()]
-    conn = remap[conn]
-    if len(unique) < used.size:
-        findings.append(Finding("WARN", f"welded {used.size:,} points into {len(unique):,} vertices (points at exactly "
-                                        "the same position; VTK's reader gives each face corner its own point when "
-                                        "an OBJ file has texture coordinates or normals)"))
-    tri, sizes = _triangulate(unique, offsets, conn)
-    if (sizes != 3).any():
-        count = Counter(sizes.tolist())
-        what = ", ".join(f"{count[k]:,} {_POLYGON_NAMES.get(k, f'{k}-gons')}" for k in sorted(count) if k != 3)
-        findings.append(Finding("WARN", f"triangulated {int((sizes != 3).sum()):,} polygons ({what}) into "
-                                        f"{len(tri):,} triangles in all (fans whose diagonals are not edges already)"))
-    faces = np.column_stack([np.full(len(tri), 3, dtype=np.int64), tri]).ravel()
-    return MeshData(pv.PolyData(unique, faces), path.name)
+    mesh, repairs = prepare_mesh(Path(path), Path(path).name)
+    findings.extend(Finding("WARN", r) for r in repairs)
+    return MeshData(mesh, Path(path).name)
 
 
 # ---------------------------------------------------------------------------------------------------- build, draw

@@ -62,7 +62,8 @@ def rotation_between(a, b) -> np.ndarray:
 def sampling_criterion(points, faces, sphere, R) -> float:
     """The 99.9th percentile of ``mesh area / image area`` over the triangles of the combined map
     ``mesh -> R sphere -> octahedral image`` (not crossing the X-cut), relative to its mean ``mesh area / 4``:
-    1 for a map of uniform density, large where the image undersamples the mesh.
+    1 for a map of uniform density, large where the image undersamples the mesh; infinite when every triangle
+    crosses the X-cut (a mesh of a few triangles: every rotation is as good).
 
     >>> from datasets_synthetic.closed_meshes import sphere_mesh
     >>> s = sphere_mesh(level=3)
@@ -77,6 +78,8 @@ def sampling_criterion(points, faces, sphere, R) -> float:
     keep = np.ptp(uv, axis=1).max(axis=1) < 0.5  # across a border of the square: not a triangle of the image
     e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
     image_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    if not keep.any():  # a mesh of a few triangles, each across a border of the square: nothing to judge
+        return float("inf")
     ratio = mesh_area[keep] / np.maximum(image_area[keep], 1e-300)
     return float(np.percentile(ratio, 99.9) / (mesh_area.sum() / 4.0))
 

@@ -85,8 +85,9 @@ def _tutte_sphere(P, F, mass, v):
     # scale so that half the surface lies inside the unit circle: the southern hemisphere
     r = np.linalg.norm(u, axis=1)
     order = np.argsort(r[inner])
-    half = np.searchsorted(np.cumsum(mass[inner][order]), 0.5 * mass[inner].sum())
-    u /= max(r[inner][order][min(half, order.size - 1)], 1e-300)
+    if order.size:  # (a tetrahedron has no inner vertex: its disk is one triangle, left as it is)
+        half = np.searchsorted(np.cumsum(mass[inner][order]), 0.5 * mass[inner].sum())
+        u /= max(r[inner][order][min(half, order.size - 1)], 1e-300)
     r2 = (u * u).sum(axis=1)
     # inverse stereographic projection from the north pole, mirrored in y: counter-clockwise in the plane is
     # outward on the sphere

@@ -6,6 +6,8 @@ The checks, in order (the first failure is raised, as :class:`splinevis.errors.M
 1. **triangles**: every cell is a triangle with three distinct vertices and non-zero area;
 2. **manifold edges**: every edge is in exactly two triangles (one: a border, the mesh is not closed; three or
    more: a non-manifold edge), used once in each direction (else the orientation flips across it);
+   **manifold vertices**: the triangles around each vertex form one fan (two fans meeting only at a vertex, a
+   pinched vertex, would pass the edge test and give a wrong Euler characteristic);
 3. **one component**: the triangles form one connected piece;
 4. **genus 0**: the Euler characteristic ``V - E + F`` is 2 (genus ``g = (2 - chi) / 2``);
 5. **outward**: the enclosed signed volume is positive (else every triangle is flipped).
@@ -40,6 +42,32 @@ def _faces(mesh) -> tuple:
         raise MeshTopologyError("triangles", f"cell {c} has {sizes[c]} vertices; triangulate the mesh first "
                                 "(pyvista: mesh.triangulate()).")
     return points, np.asarray(tri, dtype=np.int64)
+
+
+def _check_vertex_fans(tri, inv, directed, points, name):
+    """Every vertex's triangles must form one fan: corners of one vertex are joined where their triangles share
+    an edge at it; more than one group of corners is a pinched (non-manifold) vertex."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    F = len(tri)
+    order = np.argsort(inv, kind="stable")  # each edge's two directed rows (every edge is in two triangles here)
+    r1, r2 = order[0::2], order[1::2]
+    t1, j1, t2, j2 = r1 % F, r1 // F, r2 % F, r2 // F
+    # row r runs corner j to corner j+1 of triangle r % F (j = r // F); the other triangle runs the edge backwards
+    a = np.concatenate([3 * t1 + j1, 3 * t1 + (j1 + 1) % 3])
+    b = np.concatenate([3 * t2 + (j2 + 1) % 3, 3 * t2 + j2])
+    graph = coo_matrix((np.ones(a.size), (a, b)), shape=(3 * F, 3 * F))
+    _, label = connected_components(graph, directed=False)
+    pairs = np.unique(np.column_stack([tri.ravel(), label]), axis=0)
+    fans = np.bincount(pairs[:, 0], minlength=len(points))
+    pinched = np.flatnonzero(fans > 1)
+    if pinched.size:
+        v = int(pinched[0])
+        raise MeshTopologyError("manifold vertices", f"{name} is not a 2-manifold at {pinched.size} vertex(es) like "
+                                f"vertex {v} {points[v].round(6).tolist()}, where {int(fans[v])} separate fans of "
+                                "triangles meet (a pinched vertex); split the vertex, one copy per fan, or remove "
+                                "the extra fans.")
 
 
 def check_genus0(mesh, name: str = "mesh") -> dict:
@@ -86,6 +114,7 @@ def check_genus0(mesh, name: str = "mesh") -> dict:
                                 f"{a} and {b} (both triangles run it the same way); orient the triangles consistently "
                                 "(pyvista: mesh.compute_normals(auto_orient_normals=True)).")
     F = len(tri)
+    _check_vertex_fans(tri, inv.ravel(), directed, points, name)
     # triangles and edges as one graph: triangle t (row r % F of the directed edges) joined to its edges
     adj = coo_matrix((np.ones(F * 3), (np.tile(np.arange(F), 3), F + inv.ravel())), shape=(F + len(edges),) * 2)
     n_comp, labels = connected_components(adj, directed=False)
