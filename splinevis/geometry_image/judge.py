@@ -10,7 +10,7 @@
   non-manifold (two quads sharing two sides, as in ``beast.obj``, each cut along the same diagonal, make one
   triangle twice); among the fans that qualify, the one with the shortest diagonals.
 * **build**: the program's ``model_from`` (:func:`.program.model_from`, what
-  :meth:`splinevis.plotting.Plotter.add_geometry_image` does), options ``n`` (samples per side, default 65) and
+  :meth:`splinevis.plotting.Plotter.add_geometry_image` does), options ``n`` (samples per side, default "auto": :data:`.build.AUTO_SIZES`) and
   ``fairness`` (default 0.1). A mesh that is not a closed, connected, oriented genus-0 2-manifold raises
   :class:`splinevis.errors.MeshTopologyError` naming the check that failed; it is not caught (``run.py``
   makes it the FAIL).
