@@ -173,11 +173,15 @@ def test_3dm_surfaces_breps_trims_names_skipped(tmp_path):
     f3.Objects.AddLine(rhino3dm.Point3d(0, 0, 0), rhino3dm.Point3d(1, 1, 1))
     f = tmp_path / "model.3dm"
     assert f3.Write(str(f), 8)
-    with pytest.warns(UserWarning, match="skipped"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the point and the line are drawn beside the surfaces, not skipped
         m = read_nurbs(f)
     assert len(m) == 1 + 1 + 6
     assert m.names[:2] == ("bump", "disc") and m.names[2] == f"{box_id} face 0"
-    assert m.skipped == {"Point": 1, "LineCurve": 1}
+    assert m.skipped == {}
+    sketch = sorted((T.shape[1], len(P)) for _, P, T in m.companion_meshes())
+    assert sketch == [(1, 1), (2, 65)]  # the point; the line sampled at 64 segments
+    assert [P.tolist() for _, P, T in m.companion_meshes() if T.shape[1] == 1] == [[[1.0, 2.0, 3.0]]]
     s = m.surfaces[0]
     u, v = params(s)
     close(s.evaluate(u, v), [[(q := bump.PointAt(a, b)).X, q.Y, q.Z] for a, b in zip(u, v)])

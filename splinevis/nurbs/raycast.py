@@ -92,6 +92,7 @@ def newton_on_rays(model, patch, uv, origins, directions, iterations: int, *, se
     ``(n,)`` and ``derivatives (n, 2, 2, 3)`` (S, S_u, S_v with S model frame) at the result.
 
     >>> from splinevis.nurbs.exact import sphere
+    >>> from splinevis.nurbs.model import NurbsModel
     >>> m = NurbsModel([sphere()])
     >>> uv, res, d = newton_on_rays(m, np.zeros(1), np.array([[0.1, 0.45]]), np.array([[5.0, 0, 0.1]]),
     ...                             np.array([[-1.0, 0, 0]]), 8)
@@ -255,6 +256,7 @@ def reference(model, origins, directions, tmin=0.0, *, method="reference", itera
     ``iterations`` steps, the shader's residual test accepts, the nearest accepted wins (the depth test).
 
     >>> from splinevis.nurbs.exact import sphere
+    >>> from splinevis.nurbs.model import NurbsModel
     >>> h = reference(NurbsModel([sphere()]), [[0.0, 0.0, 5.0], [3.0, 3.0, 5.0]], [[0.0, 0.1, -1.0], [0, 0, -1.0]])
     >>> np.round(h.t, 9).tolist()[0], bool(h.hit[1])
     (4.087346744, False)
@@ -289,6 +291,7 @@ def residual_tolerance(surface, facts, Su, Sv, ray_origin_size):
     The residual's own evaluation (S - ro and two dot products) adds 8 u (M + |ro|). Threshold: twice the sum.
 
     >>> from splinevis.nurbs.exact import saddle
+    >>> from splinevis.nurbs.model import NurbsModel
     >>> s = saddle()
     >>> f = patch_facts(NurbsModel([s]))[0]
     >>> round(float(residual_tolerance(s, f, np.zeros(3), np.zeros(3), 1.0) / U32), 3)
@@ -318,6 +321,7 @@ def depth_bound(model, matrix, origins, directions, t):
     :func:`splinevis.gl.error_bounds.depth_error`, which adds the clip-space arithmetic and quantization.
 
     >>> from splinevis.nurbs.exact import sphere
+    >>> from splinevis.nurbs.model import NurbsModel
     >>> m = NurbsModel([sphere()])
     >>> b = depth_bound(m, np.eye(4), np.array([[0.0, 0.0, -5.0]]), np.array([[0.0, 0.0, 1.0]]), np.array([4.0]))
     >>> bool(0 < b[0] < 1e-4)  # a few hundred u: a well-conditioned hit at the pole
