@@ -23,8 +23,11 @@ def _breaks(knots, lo, hi):
 
 
 def _piece_params(breaks, n):
+    """``n`` parameters per interval of ``breaks`` (at fractions k / n, each interval at once) and the last break."""
     t = np.linspace(0.0, 1.0, n + 1)[:-1]
-    return np.concatenate([at_fraction(a, b, t) for a, b in zip(breaks[:-1], breaks[1:])] + [breaks[-1:]])
+    breaks = np.asarray(breaks, dtype=np.float64)
+    inner = at_fraction(breaks[:-1, None], breaks[1:, None], t[None, :]).ravel()
+    return np.concatenate([inner, breaks[-1:]])
 
 
 def _gauss_nodes(breaks, g, min_intervals):
