@@ -138,25 +138,29 @@ def test_trim_cuts_match_numpy_polynomial_and_the_evaluation_the_plain_code():
     assert np.array_equal(f(t, 0), ref[:, 0]) and np.array_equal(f(t, 1), ref[:, 1])
 
 
-@pytest.mark.gl
-def test_gpu_cylinder_and_box_on_the_adaptive_shell_match_the_twin():
+def _gpu_and_twin_hits(model, camera):
+    """Pixels the GPU program covers (depth < 1) and those the float64 twin hits, 160 x 120 from ``camera``."""
     import splinevis
     from splinevis.gl.camera import pixel_rays
     from splinevis.nurbs.program import PROGRAM
 
-    model = NurbsModel([cylinder(1.0, 2.0, (3.0, 0.0, 0.0)), *box_faces(1.5, 1.0, 0.8)])
     pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
     pl.add_nurbs(model, lights=1)
-    pl.camera_position = [(8.0, -9.0, 6.0), (1.5, 0.0, 0.5), (0, 0, 1)]
+    pl.camera_position = camera
     pl.reset_camera_clipping_range()
     img = pl.screenshot()
     depth, matrix = pl.depth_buffer(), pl.camera_matrix()
     pl.close()
     o, d = pixel_rays(matrix, *img.shape[1::-1])
-    ref = PROGRAM.raycast(model, o, d)
-    gpu_hit = depth < 1.0
+    return depth < 1.0, PROGRAM.raycast(model, o, d).hit
+
+
+@pytest.mark.gl
+def test_gpu_cylinder_and_box_on_the_adaptive_shell_match_the_twin():
+    model = NurbsModel([cylinder(1.0, 2.0, (3.0, 0.0, 0.0)), *box_faces(1.5, 1.0, 0.8)])
+    gpu_hit, twin_hit = _gpu_and_twin_hits(model, [(8.0, -9.0, 6.0), (1.5, 0.0, 0.5), (0, 0, 1)])
     assert gpu_hit.mean() > 0.05
-    assert (gpu_hit != ref.hit).sum() <= 0.002 * gpu_hit.size
+    assert (gpu_hit != twin_hit).sum() <= 0.002 * gpu_hit.size
 
 
 def _bunched_ruled(rows=(0.0, 0.05, 0.1, 1.0)):
@@ -184,20 +188,7 @@ def test_a_straight_span_at_varying_speed_keeps_its_cells():
 
 @pytest.mark.gl
 def test_gpu_finds_every_hit_on_rulings_traced_at_varying_speed():
-    import splinevis
-    from splinevis.gl.camera import pixel_rays
-    from splinevis.nurbs.program import PROGRAM
-
-    model = NurbsModel([_bunched_ruled()])
-    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
-    pl.add_nurbs(model, lights=1)
-    pl.camera_position = [(5.0, -6.0, 6.0), (0.0, 0.5, 2.0), (0, 0, 1)]
-    pl.reset_camera_clipping_range()
-    img = pl.screenshot()
-    depth, matrix = pl.depth_buffer(), pl.camera_matrix()
-    pl.close()
-    o, d = pixel_rays(matrix, *img.shape[1::-1])
-    ref = PROGRAM.raycast(model, o, d)
-    gpu_hit = depth < 1.0
-    assert ref.hit.mean() > 0.05
-    assert (gpu_hit != ref.hit).sum() <= 0.002 * gpu_hit.size
+    camera = [(5.0, -6.0, 6.0), (0.0, 0.5, 2.0), (0, 0, 1)]
+    gpu_hit, twin_hit = _gpu_and_twin_hits(NurbsModel([_bunched_ruled()]), camera)
+    assert twin_hit.mean() > 0.05
+    assert (gpu_hit != twin_hit).sum() <= 0.002 * gpu_hit.size

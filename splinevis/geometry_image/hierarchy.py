@@ -72,8 +72,6 @@ def _candidate_edges(P, F, A, deg):
     ok = (common == 2) & (deg[x] > 3) & (deg[y] > 3)
     v = np.concatenate([lo[ok], hi[ok]])
     u = np.concatenate([hi[ok], lo[ok]])
-    ok_v = deg[v] >= 3
-    v, u = v[ok_v], u[ok_v]
     return v, u, np.linalg.norm(P[v] - P[u], axis=1)
 
 
@@ -151,28 +149,33 @@ def simplify(P, F, *, base: int = 4) -> tuple:
     return F, rounds
 
 
-def _tetrahedron(F):
-    """Unit vectors of a regular tetrahedron for the four vertices of ``F``, every triangle outward."""
+def _tetrahedron(F, n):
+    """``(n, 3)``: unit vectors of a regular tetrahedron for the four vertices of ``F``, every triangle outward
+    (the other rows zero)."""
     ids = np.unique(F)
-    X = np.zeros((int(F.max()) + 1, 3))
+    X = np.zeros((n, 3))
     X[ids] = _unit(np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]]))
     if (_det(X, F) < 0).all():
         X[ids[[0, 1]]] = X[ids[[1, 0]]]
     return X
 
 
-def _insert(X, removed, target, F):
-    """Place each removed vertex near its target with all its triangles of ``F`` outward (module docstring);
-    returns the vertices it could not place (empty when all are placed)."""
-    mine = np.isin(F, removed)
-    rows = np.flatnonzero(mine.any(axis=1))
-    T = F[rows]
+def _stars(F, removed):
+    """The triangles of ``F`` around the removed vertices, each turned to start there, ``(v, a, b)`` in the same
+    orientation, and for each the index of its vertex in ``removed`` (no triangle has two: their neighbourhoods
+    are disjoint)."""
+    T = F[np.isin(F, removed).any(axis=1)]
     k = np.argmax(np.isin(T, removed), axis=1)
-    T = np.stack([T[np.arange(len(T)), k], T[np.arange(len(T)), (k + 1) % 3], T[np.arange(len(T)), (k + 2) % 3]],
-                 axis=1)  # (v, a, b), same orientation
+    r = np.arange(len(T))
+    T = np.stack([T[r, k], T[r, (k + 1) % 3], T[r, (k + 2) % 3]], axis=1)
     slot = np.full(int(F.max()) + 1, -1)
     slot[removed] = np.arange(removed.size)
-    owner = slot[T[:, 0]]
+    return T, slot[T[:, 0]]
+
+
+def _insert(X, removed, target, T, owner):
+    """Place each removed vertex near its target with all its triangles (``T``, ``owner``: :func:`_stars`)
+    outward (module docstring); returns the vertices it could not place (empty when all are placed)."""
     u = target[owner]
     # the two triangles on the collapsed edge: (v, u, x) and (v, y, u); the corner at u spans x..y
     x = np.zeros(removed.size, dtype=np.int64)
@@ -199,20 +202,12 @@ def _insert(X, removed, target, F):
     return removed[~placed]
 
 
-def _center_inserted(X, removed, F, iterations: int = 60):
+def _center_inserted(X, removed, T, owner, iterations: int = 60):
     """Move each inserted vertex to the analytic centre of its ring's kernel on the sphere: the maximum of
     ``sum log det[x, a, b]`` over its triangles ``(x, a, b)`` (the region where all of them are outward is the
     intersection of the hemispheres ``x . (a x b) > 0``). Damped Newton steps in the tangent plane, each halved
     until every triangle stays outward and the sum grows; a vertex placed a hair from its target moves out to
-    where its triangles are as far from flat as its ring allows."""
-    mine = np.isin(F, removed)
-    T = F[mine.any(axis=1)]
-    k = np.argmax(np.isin(T, removed), axis=1)
-    r = np.arange(len(T))
-    T = np.stack([T[r, k], T[r, (k + 1) % 3], T[r, (k + 2) % 3]], axis=1)
-    slot = np.full(int(F.max()) + 1, -1)
-    slot[removed] = np.arange(removed.size)
-    owner = slot[T[:, 0]]
+    where its triangles are as far from flat as its ring allows (``T``, ``owner``: :func:`_stars`)."""
     C = np.cross(X[T[:, 1]], X[T[:, 2]])  # det[x, a, b] = x . (a x b)
     m = removed.size
 
@@ -285,8 +280,7 @@ def hierarchical_sphere(P, F, *, relax_steps: int = 10, progress: bool = False) 
     base, rounds = simplify(P, F)
     nbase = np.unique(base).size
     if nbase == 4:
-        X = _tetrahedron(base)
-        X = np.vstack([X, np.zeros((len(P) - len(X), 3))]) if len(X) < len(P) else X
+        X = _tetrahedron(base, len(P))
     else:  # no collapse allowed before a tetrahedron: the Tutte start of the base mesh
         ids = np.unique(base)
         local = np.searchsorted(ids, base)
@@ -302,11 +296,12 @@ def hierarchical_sphere(P, F, *, relax_steps: int = 10, progress: bool = False) 
         bar = tqdm(total=len(rounds), desc="coarse to fine", unit="level")
     relaxed_at = nbase
     for removed, target, faces in reversed(rounds):
-        lost = _insert(X, removed, target, faces)
+        T, owner = _stars(faces, removed)
+        lost = _insert(X, removed, target, T, owner)
         if lost.size:
             raise RuntimeError(f"coarse to fine: {lost.size} vertices (e.g. {int(lost[0])}) found no place with "
                                "all their triangles outward.")
-        _center_inserted(X, removed, faces)
+        _center_inserted(X, removed, T, owner)
         ids = np.unique(faces)
         if ids.size < len(P) and (ids.size <= RELAX_ALWAYS or ids.size >= GROWTH * relaxed_at):
             local = np.searchsorted(ids, faces)

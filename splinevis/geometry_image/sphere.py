@@ -196,7 +196,8 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
             break
         except RuntimeError as err:
             failure = str(err)
-    squeezed = X is not None and start == "auto" and S.report(X)["l2"] > SQUEEZED
+    l2_start = S.report(X)["l2"] if X is not None else None
+    squeezed = l2_start is not None and start == "auto" and l2_start > SQUEEZED
     if X is None and start == "tutte":
         raise RuntimeError(failure + " (start='auto' or 'hierarchy' builds the coarse-to-fine start)")
     if X is None or squeezed:
@@ -207,13 +208,13 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
             Y, info = hierarchical_sphere(P, F, progress=bool(progress))
             _check_one_to_one(Y, F, name, "the coarse-to-fine start")
             X, method = Y, f"coarse to fine ({info['levels']} levels)"
+            l2_start = S.report(X)["l2"]
         except RuntimeError as err:
             if X is None:
                 raise RuntimeError(f"{failure}; and {err}") from err
         timings["hierarchy"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    l2_start = S.report(X)["l2"]
     X, steps = _relax(X, S, int(iterations), bool(progress), float(tol))
     timings["relax"] = time.perf_counter() - t
 
