@@ -148,22 +148,7 @@ class NurbsSurface:
         (array([2., 0., 1.]), array([0., 1., 1.]))
         """
         u, v = self._params(u, v)
-        Aw = self._homogeneous_derivatives(u, v, order)  # (m, d+1, d+1, 4)
-        A, w = Aw[..., :3], Aw[..., 3]
-        SKL = np.zeros_like(A)
-        for k in range(order + 1):
-            for l in range(order - k + 1):
-                val = A[:, k, l].copy()
-                for j in range(1, l + 1):
-                    val -= comb(l, j) * w[:, 0, j, None] * SKL[:, k, l - j]
-                for i in range(1, k + 1):
-                    val -= comb(k, i) * w[:, i, 0, None] * SKL[:, k - i, l]
-                    v2 = np.zeros_like(val)
-                    for j in range(1, l + 1):
-                        v2 += comb(l, j) * w[:, i, j, None] * SKL[:, k - i, l - j]
-                    val -= comb(k, i) * v2
-                SKL[:, k, l] = val / w[:, 0, 0, None]
-        return SKL
+        return _rational(self._homogeneous_derivatives(u, v, order), order)
 
     def evaluate(self, u, v) -> np.ndarray:
         """Points ``S(u, v)``, shape ``(len(u), 3)``.
@@ -233,6 +218,26 @@ class NurbsSurface:
         # the one three-operand sum; numpy's own loops, not BLAS, so the bits do not follow the BLAS kernels)
         rows = np.einsum("mlb,mabc->malc", Nv, net)
         return np.einsum("mka,malc->mklc", Nu, rows)
+
+
+def _rational(Aw: np.ndarray, order: int) -> np.ndarray:
+    """The surface's derivatives ``SKL`` (m, d+1, d+1, 3) from the homogeneous ones ``Aw`` (m, d+1, d+1, 4) by
+    the quotient rule [PieglTiller1997, A4.4]."""
+    A, w = Aw[..., :3], Aw[..., 3]
+    SKL = np.zeros_like(A)
+    for k in range(order + 1):
+        for l in range(order - k + 1):
+            val = A[:, k, l].copy()
+            for j in range(1, l + 1):
+                val -= comb(l, j) * w[:, 0, j, None] * SKL[:, k, l - j]
+            for i in range(1, k + 1):
+                val -= comb(k, i) * w[:, i, 0, None] * SKL[:, k - i, l]
+                v2 = np.zeros_like(val)
+                for j in range(1, l + 1):
+                    v2 += comb(l, j) * w[:, i, j, None] * SKL[:, k - i, l - j]
+                val -= comb(k, i) * v2
+            SKL[:, k, l] = val / w[:, 0, 0, None]
+    return SKL
 
 
 def _unit_normal(SKL: np.ndarray, with_mask: bool = False):

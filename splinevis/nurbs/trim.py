@@ -23,7 +23,7 @@ import numpy as np
 
 from .operations import bezier_segments
 
-__all__ = ["TrimPieces", "trim_pieces", "inside", "MAX_TRIM_DEGREE", "PIECE_FLOATS"]
+__all__ = ["TrimPieces", "trim_pieces", "inside", "inside_many", "MAX_TRIM_DEGREE", "PIECE_FLOATS"]
 
 #: Highest trim-curve degree the per-fragment test handles.
 MAX_TRIM_DEGREE = 3
@@ -66,7 +66,10 @@ def _bezier_segments(curve):
     """Homogeneous Bezier segments (k, p+1, 3) of a TrimCurve (:func:`splinevis.nurbs.operations.bezier_segments`)."""
     w = np.ones(len(curve.control_points)) if curve.weights is None else curve.weights
     Pw = np.column_stack([curve.control_points * w[:, None], w])
-    return np.asarray(bezier_segments(curve.degree, curve.knots, Pw, "trim curve knots"))
+    p, U = curve.degree, curve.knots
+    if len(Pw) == p + 1 and U[0] == U[p] and U[p + 1] == U[-1]:  # one clamped span: its net is the segment
+        return Pw[None]
+    return np.asarray(bezier_segments(p, U, Pw, "trim curve knots"))
 
 
 def _split(seg, t):
@@ -249,29 +252,56 @@ def inside(pieces: TrimPieces, patch: int, u, v, iterations: int = 60) -> np.nda
     [False, False, True, True]
     """
     u = np.atleast_1d(np.asarray(u, dtype=np.float64))
-    v = np.atleast_1d(np.asarray(v, dtype=np.float64))
     s, c = int(pieces.start[patch]), int(pieces.count[patch])
-    if c == 0:
-        return np.ones(u.shape, dtype=bool)
-    ctrl, deg, box = pieces.ctrl[s: s + c], pieces.degree[s: s + c], pieces.bbox[s: s + c]
-    first = ctrl[np.arange(c), 0, 1] / ctrl[np.arange(c), 0, 2]
-    last = ctrl[np.arange(c), deg, 1] / ctrl[np.arange(c), deg, 2]
+    own = TrimPieces(pieces.ctrl[s: s + c], pieces.degree[s: s + c], pieces.bbox[s: s + c], np.zeros(1, dtype=np.int64),
+                     np.array([c]))  # the patch's pieces alone
+    return inside_many(own, np.zeros(u.shape, dtype=np.int64), u, v, iterations).reshape(u.shape)
+
+
+def inside_many(pieces: TrimPieces, patch, u, v, iterations: int = 60, pairs: int = 1 << 20) -> np.ndarray:
+    """:func:`inside` of each parameter ``(u[i], v[i])`` in its own patch ``patch[i]`` (the same test, point by
+    point, for points of many patches at once; at most ``pairs`` point-piece pairs at a time).
+
+    >>> from splinevis.nurbs.model import TrimCurve
+    >>> square = [TrimCurve(1, [0, 0, 1, 1], [a, b]) for a, b in
+    ...           [((0.2, 0.2), (0.8, 0.2)), ((0.8, 0.2), (0.8, 0.8)), ((0.8, 0.8), (0.2, 0.8)), ((0.2, 0.8), (0.2, 0.2))]]
+    >>> inside_many(trim_pieces([[square], None]), [0, 0, 1], [0.5, 0.1, 0.1], [0.5, 0.5, 0.5]).tolist()
+    [True, False, True]
+    """
+    u = np.atleast_1d(np.asarray(u, dtype=np.float64)).ravel()
+    v = np.atleast_1d(np.asarray(v, dtype=np.float64)).ravel()
+    patch = np.atleast_1d(np.asarray(patch, dtype=np.int64)).ravel()
+    ctrl, deg, box = pieces.ctrl, pieces.degree, pieces.bbox
+    n = len(deg)
+    first = ctrl[np.arange(n), 0, 1] / ctrl[np.arange(n), 0, 2]
+    last = ctrl[np.arange(n), deg, 1] / ctrl[np.arange(n), deg, 2]
     lo, hi = np.minimum(first, last), np.maximum(first, last)
-    U, V = u[:, None], v[:, None]
-    spans = (V >= lo) & (V < hi)  # half-open: a vertex shared by two pieces is counted once
-    sure = spans & (box[:, 0] > U)  # the whole hull right of u0
-    unsure = spans & ~sure & (box[:, 1] > U)
-    crossings = sure.sum(axis=1)
-    pi, pk = np.nonzero(unsure)
-    if pi.size:
-        up = last[pk] > first[pk]
-        a, b = np.zeros(pi.size), np.ones(pi.size)
-        evaluate = _evaluator(ctrl[pk], deg[pk])  # the pieces sorted by degree once, not at every step
-        for _ in range(iterations):  # bisection on the monotone v(t) = v0
-            m = 0.5 * (a + b)
-            vm = evaluate(m, 1)
-            below = (vm < v[pi]) == up
-            a, b = np.where(below, m, a), np.where(below, b, m)
-        um = evaluate(0.5 * (a + b), 0)
-        np.add.at(crossings, pi, (um > u[pi]).astype(int))
-    return crossings % 2 == 1
+    count = np.asarray(pieces.count, dtype=np.int64)[patch]
+    start = np.asarray(pieces.start, dtype=np.int64)[patch]
+    crossings = np.zeros(u.size, dtype=np.int64)
+    ends = np.cumsum(count)
+    a = 0
+    while a < u.size:  # chunks of at most ``pairs`` pairs (at least one point)
+        b = max(int(np.searchsorted(ends, (ends[a - 1] if a else 0) + pairs, side="right")), a + 1)
+        c = count[a:b]
+        pi = np.repeat(np.arange(a, b), c)
+        pk = np.repeat(start[a:b] - (np.cumsum(c) - c), c) + np.arange(pi.size)
+        U, V = u[pi], v[pi]
+        spans = (V >= lo[pk]) & (V < hi[pk])  # half-open: a vertex shared by two pieces is counted once
+        sure = spans & (box[pk, 0] > U)  # the whole hull right of u0
+        unsure = spans & ~sure & (box[pk, 1] > U)
+        crossings[a:b] += np.bincount(pi[sure] - a, minlength=b - a)
+        pi, pk = pi[unsure], pk[unsure]
+        if pi.size:
+            up = last[pk] > first[pk]
+            lo_t, hi_t = np.zeros(pi.size), np.ones(pi.size)
+            evaluate = _evaluator(ctrl[pk], deg[pk])  # the pieces sorted by degree once, not at every step
+            for _ in range(iterations):  # bisection on the monotone v(t) = v0
+                m = 0.5 * (lo_t + hi_t)
+                vm = evaluate(m, 1)
+                below = (vm < v[pi]) == up
+                lo_t, hi_t = np.where(below, m, lo_t), np.where(below, hi_t, m)
+            um = evaluate(0.5 * (lo_t + hi_t), 0)
+            crossings[a:b] += np.bincount(pi[um > u[pi]] - a, minlength=b - a)
+        a = b
+    return (crossings % 2 == 1) | (count == 0)  # an untrimmed patch keeps everything
