@@ -71,4 +71,10 @@ def test_walkthrough_example_flies_through_teapots_and_logs_every_frame(tmp_path
     assert len(rows) == 1 + 48 and rows[0].startswith("frame,time_ms,triangles")
     assert all(int(r.split(",")[2]) > 0 for r in rows[1:])  # every frame drew triangles
     img = np.asarray(Image.open(tmp_path / "summary.png").convert("RGB")).astype(int)
-    assert img.shape == (600, 3200, 3) and (~np.all(img > 250, axis=-1)).mean() > 0.1
+    drawn = ~np.all(img > 250, axis=-1)
+    # Frame 0 is drawn from the mesh built for its own camera before the flight starts, so it is the same on
+    # every machine (6.9 % of its pixels show the teapots). Later frames show the newest mesh the worker threads
+    # finished, selected and culled for a camera up to ``mesh_age`` frames old, so how much of them is covered
+    # follows the machine's load (10-22 % of the strip measured); they only have to show the model at all.
+    assert img.shape == (600, 3200, 3) and drawn[:, :800].mean() > 0.05
+    assert all(drawn[:, k * 800:(k + 1) * 800].any() for k in range(1, 4))
