@@ -29,7 +29,6 @@ Examples
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 

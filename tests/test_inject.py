@@ -5,7 +5,6 @@ import pytest
 import pyvista as pv
 
 import splinevis
-from splinevis import Style
 from splinevis.analysis.composite import UNLIT, front_surface_agreement
 from splinevis.analytic import QuarticTrianglePatch
 from splinevis.errors import ShaderCompileError

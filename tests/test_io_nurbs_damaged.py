@@ -212,9 +212,9 @@ def test_iges_directory_lines_garbled(iges_text, tmp_path):
     with pytest.raises(DamagedFileError) as err:
         read_nurbs(f)
     msg = str(err.value)
-    assert f"1 directory entries are unreadable (what they held is lost)" in msg
+    assert "1 directory entries are unreadable (what they held is lost)" in msg
     assert f"directory entries {de} are incomplete" in msg
-    assert f"2 lines are not IGES records" in msg and f"{first_d + de}-{first_d + de + 1}" in msg
+    assert "2 lines are not IGES records" in msg and f"{first_d + de}-{first_d + de + 1}" in msg
     m, warning = partial(f)
     assert len(m) == FACES - 1 and m.skipped == {"unreadable directory entries": 1}
     intact = tmp_path / "intact.igs"

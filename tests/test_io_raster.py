@@ -15,7 +15,7 @@ from rasterio.crs import CRS
 from datasets_synthetic.dem_files import write_geotiff
 from splinevis.io import SUPPORTED_EXTENSIONS, read_heights
 from splinevis.io.georef import degree_lengths
-from splinevis.io.raster import RasterOpenError, read_raster
+from splinevis.io.raster import read_raster
 
 UTM = (5e5, 5.1e6)
 

@@ -56,7 +56,7 @@ def test_the_plain_formula_leaves_the_domain_and_at_fraction_does_not():
 @pytest.mark.parametrize("domain", REAL_DOMAINS, ids=lambda d: f"[{d[0]!r}, {d[1]!r}]")
 def test_every_path_from_a_domain_to_parameters_stays_inside(domain):
     """Failed before the helper with "parameter ... is outside the knot domain" (the Rhino and STEP domains)."""
-    from splinevis.nurbs import continuity, raycast, shell, tessellate
+    from splinevis.nurbs import continuity, shell, tessellate
     from splinevis.nurbs.pullback import _Inverter
 
     s = _surface(domain, domain)

@@ -405,7 +405,7 @@ def test_insert_and_refine_keep_the_surface(seed):
         c = insert_knot(s, "u", x, left)
         assert int(np.count_nonzero(c.knots[0] == x)) == p
         assert_same_geometry(s, c, rng, "insert_knot to multiplicity p")
-        with pytest.raises(ValueError, match=rf"insert it at most 0 more time"):
+        with pytest.raises(ValueError, match=r"insert it at most 0 more time"):
             insert_knot(c, "u", x)
 
 

@@ -8,7 +8,6 @@ checks the generated file is current and compares it with splinevis.bb.simplex.r
 
 from pathlib import Path
 
-import numpy as np
 
 from splinevis.bb.simplex import multi_indices
 

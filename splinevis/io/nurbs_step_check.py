@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .nurbs_common import Damage
 
 
 # Structure check (see "Damaged files" in the module notes)

@@ -23,7 +23,7 @@ import numpy as np
 from ..nurbs import NurbsModel, NurbsSurface
 from .nurbs_common import build_model, checked
 
-__all__ = ["read_g2", "read_geomdl_json", "read_bpt"]
+__all__ = ["read_geomdl_json", "read_bpt"]
 
 def _bezier_knots(p: int) -> list:
     return [0.0] * (p + 1) + [1.0] * (p + 1)

@@ -202,8 +202,8 @@ def catmull_clark(net: SubdNet, rule: str = "standard") -> SubdNet:
     >>> net.points.shape, net.fsize.size, net.all_quads
     ((26, 3), 24, True)
     """
-    P, fv, cf, nx = net.points, net.fv, net.cf, net.nx
-    nv, ne, nf = P.shape[0], net.edges.shape[0], net.fsize.size
+    P, fv, cf = net.points, net.fv, net.cf
+    nv, ne = P.shape[0], net.edges.shape[0]
     C = np.add.reduceat(P[fv], net.fstart, axis=0) / net.fsize[:, None]
     A, B = P[net.edges[:, 0]], P[net.edges[:, 1]]
     sm = ~net.crease
