@@ -31,6 +31,42 @@ def test_a_triangle_soup_is_welded_and_the_weld_reported():
     assert report.vertices == m.n_points and report.triangles == m.n_cells and len(report.repairs) == 1
 
 
+def test_positions_written_twice_with_float32_rounding_are_welded_within_the_tolerance():
+    from splinevis.geometry_image.repair import prepare_mesh
+
+    m = sphere_mesh(level=2)
+    soup = _soup(m)
+    # each corner written from float32 by an exporter that moved the mesh first: positions of one vertex differ
+    # in their last float32 bits: two copies differ by <= 2 x 2^-23 per coordinate (coordinates of size 1, the
+    # unit sphere's), sqrt(3) x 2^-22 = 4.1e-7 in all, far below WELD_TOLERANCE x diagonal (2 sqrt(3) = 3.5e-6)
+    # and far above 0 (exact welding keeps them apart)
+    jitter = np.random.default_rng(0).integers(-1, 2, size=soup.points.shape) * 2.0 ** -23
+    soup.points = (np.asarray(soup.points, dtype=np.float64) + jitter).astype(np.float32).astype(np.float64)
+    welded, repairs = prepare_mesh(soup, "float32 soup")
+    assert welded.n_points == m.n_points and welded.n_cells == m.n_cells
+    assert "of the bounding box's diagonal; the largest distance merged is" in repairs[0]
+    check_genus0(welded)  # closed again
+    exact, _ = prepare_mesh(soup, "float32 soup", weld_tolerance=0)
+    assert exact.n_points > m.n_points
+
+
+def test_a_face_whose_corners_weld_together_is_removed_and_counted():
+    from splinevis.geometry_image.repair import prepare_mesh
+
+    m = sphere_mesh(level=2)
+    P = np.asarray(m.points, dtype=np.float64)
+    F = m.faces.reshape(-1, 4)[:, 1:]
+    # a sliver: a new point 1e-9 from vertex F[0, 0], replacing it in face 0 only; a triangle between it and
+    # the two corners would have an edge of 1e-9 (below the tolerance): that face welds into a segment
+    sliver = np.array([[F[0, 0], len(P), F[0, 1]]])
+    P2 = np.vstack([P, P[F[0, 0]] + 1e-9])
+    faces = np.vstack([F, sliver])
+    mesh = pv.PolyData(P2, np.column_stack([np.full(len(faces), 3), faces]).ravel())
+    welded, repairs = prepare_mesh(mesh, "sliver")
+    assert welded.n_points == m.n_points and welded.n_cells == m.n_cells
+    assert any(r.startswith("removed 1 faces whose corners welded") for r in repairs)
+
+
 def test_quads_are_triangulated_without_repeating_an_edge():
     cube = pv.Cube().clean()  # 6 quads
     with warnings.catch_warnings(record=True) as caught:

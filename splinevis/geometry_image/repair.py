@@ -4,9 +4,17 @@ triangle mesh with one vertex per position. Each repair is reported, none is sil
 * **read**: OBJ, PLY, STL, VTP, ... with pyvista; OFF with libigl (VTK has no OFF reader); point and line cells
   are ignored (counted);
 * **unused points** (no face uses them) are dropped;
-* **welding**: points at exactly the same position become one vertex (VTK's OBJ reader gives every face corner
-  its own point when the file has texture coordinates or normals, so the mesh arrives as a soup of separate
-  faces); the vertices keep the file's order, so a mesh needing no repair keeps its numbering;
+* **welding**: points closer than a tolerance become one vertex (VTK's OBJ reader gives every face corner its
+  own point when the file has texture coordinates or normals, so the mesh arrives as a soup of separate faces;
+  exporters that split normals write a position once per face). The tolerance is relative to the bounding
+  box's diagonal ``D``, :data:`WELD_TOLERANCE` by default: a position written twice from one value differs by
+  its storage rounding at most, ``2^-24`` of the coordinate for float32 (STL, PLY) and ``5e-7`` relative for
+  the 7 significant digits common in ASCII files, so a few ``1e-7 D`` for coordinates of the box's size; while
+  the shortest edge of a scan is rarely below ``1e-4 D`` (``1e-6 D`` would be a 10^6 x 10^6 vertex grid).
+  Points chained within the tolerance form one vertex at the position of the cluster's first point in the file;
+  the largest distance merged is reported. A face whose corners weld together (an edge shorter than the
+  tolerance) is removed and counted. The vertices keep the file's order, so a mesh needing no repair keeps its
+  numbering;
 * **polygons** are triangulated, each into a fan whose diagonals are not edges of the mesh already (a fixed fan
   can make a closed quad mesh non-manifold: two quads sharing two sides, each cut along the same diagonal, make
   one triangle twice); among the fans that qualify, the one with the shortest diagonals.
@@ -22,7 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["prepare_mesh"]
+__all__ = ["prepare_mesh", "WELD_TOLERANCE"]
+
+#: Default welding tolerance, relative to the bounding box's diagonal (module docstring).
+WELD_TOLERANCE = 1e-6
 
 _POLYGON_NAMES = {3: "triangles", 4: "quads", 5: "pentagons", 6: "hexagons"}
 
@@ -43,6 +54,58 @@ def _polygons_from_vtk(mesh):
         offsets = np.concatenate([offsets, offsets[-1] + 3 * np.arange(1, len(t) + 1)])
         conn = np.concatenate([conn, t.ravel()])
     return points, offsets, conn, int(mesh.n_verts + mesh.n_lines)
+
+
+def _diagonal(points) -> float:
+    return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if len(points) else 0.0
+
+
+def _weld(points, tolerance: float):
+    """``(vertices, rank, largest)``: one vertex per cluster of ``points`` chained closer than ``tolerance`` x
+    the diagonal (module docstring), in the order of each cluster's first point; ``rank[i]`` is point ``i``'s
+    vertex; ``largest`` the largest distance from a point to its vertex (0 when only exact copies merged)."""
+    _, first, inverse = np.unique(points + 0.0, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    r = float(tolerance) * _diagonal(points)
+    if r > 0 and len(first) > 1:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+        from scipy.spatial import cKDTree
+
+        distinct = points[first]
+        pairs = cKDTree(distinct).query_pairs(r, output_type="ndarray")
+        if len(pairs):
+            graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(first),) * 2)
+            _, label = connected_components(graph, directed=False)
+            # every distinct position's cluster, represented by the cluster's first point in the file
+            head = np.full(label.max() + 1, len(points), dtype=np.int64)
+            np.minimum.at(head, label, first)
+            first, cluster = np.unique(head[label], return_inverse=True)
+            inverse = cluster.ravel()[inverse]
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[order] = np.arange(len(first))
+    vertices = points[first[order]]
+    largest = float(np.linalg.norm(points - vertices[rank[inverse]], axis=1).max()) if len(points) else 0.0
+    return vertices, rank[inverse], largest
+
+
+def _drop_collapsed(offsets, conn):
+    """Polygons without the ones that have fewer than 3 distinct corners after welding: ``(offsets, conn,
+    removed)``."""
+    sizes = np.diff(offsets)
+    keep = np.ones(len(sizes), dtype=bool)
+    for k in np.unique(sizes).tolist():
+        idx = np.flatnonzero(sizes == k)
+        ring = np.sort(conn[offsets[idx][:, None] + np.arange(k)], axis=1)
+        distinct = 1 + (np.diff(ring, axis=1) != 0).sum(axis=1)
+        keep[idx[distinct < 3]] = False
+    if keep.all():
+        return offsets, conn, 0
+    cell = np.repeat(np.arange(len(sizes)), sizes)
+    conn = conn[keep[cell]]
+    offsets = np.concatenate([[0], np.cumsum(sizes[keep])]).astype(np.int64)
+    return offsets, conn, int((~keep).sum())
 
 
 def _triangulate(points, offsets, conn):
@@ -86,9 +149,11 @@ def _triangulate(points, offsets, conn):
     return np.concatenate(triangles).astype(np.int64), sizes
 
 
-def prepare_mesh(mesh, name: str = "mesh") -> tuple:
+def prepare_mesh(mesh, name: str = "mesh", weld_tolerance: float = WELD_TOLERANCE) -> tuple:
     """``(PolyData, repairs)``: ``mesh`` (a pyvista DataSet or a file name) as one triangle mesh with one vertex
     per position, and a list of sentences saying what was changed (module docstring); empty when nothing was.
+    ``weld_tolerance``: points closer than this share of the bounding box's diagonal become one vertex (0: only
+    points at exactly the same position).
 
     >>> import pyvista as pv
     >>> soup = pv.PolyData(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]]),
@@ -124,17 +189,20 @@ def prepare_mesh(mesh, name: str = "mesh") -> tuple:
     used = np.unique(conn)
     if used.size < len(points):
         repairs.append(f"dropped {len(points) - used.size:,} of {len(points):,} points that no face uses")
-    _, first, inverse = np.unique(points[used] + 0.0, axis=0, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    unique = points[used][np.sort(first)]
+    unique, rank, merged = _weld(points[used], weld_tolerance)
     remap = np.empty(len(points), dtype=np.int64)
-    remap[used] = rank[inverse.ravel()]
+    remap[used] = rank
     conn = remap[conn]
     if len(unique) < used.size:
-        repairs.append(f"welded {used.size:,} points into {len(unique):,} vertices (points at exactly the same "
-                       "position; VTK's reader gives each face corner its own point when an OBJ file has texture "
-                       "coordinates or normals)")
+        how = ("points at exactly the same position" if merged == 0 else
+               f"points within {weld_tolerance:g} of the bounding box's diagonal; the largest distance merged is "
+               f"{merged:.3g}, {merged / _diagonal(points[used]):.2g} of the diagonal")
+        repairs.append(f"welded {used.size:,} points into {len(unique):,} vertices ({how}; VTK's reader gives each "
+                       "face corner its own point when an OBJ file has texture coordinates or normals)")
+    offsets, conn, collapsed = _drop_collapsed(offsets, conn)
+    if collapsed:
+        repairs.append(f"removed {collapsed:,} faces whose corners welded into fewer than 3 vertices (edges "
+                       f"shorter than {weld_tolerance:g} of the diagonal)")
     tri, sizes = _triangulate(unique, offsets, conn)
     if (sizes != 3).any():
         count = Counter(sizes.tolist())
