@@ -11,7 +11,7 @@ import pytest
 from _cut_vertex import cone_measure
 from datasets_synthetic import closed_meshes as cm
 from splinevis.errors import MeshTopologyError
-from splinevis.geometry_image.build import FOLDED_WARNING, geometry_image_from_mesh
+from splinevis.geometry_image.build import FOLDED_WARNING, FOLD_LEVEL, geometry_image_from_mesh
 
 SHAPES = ["sphere_mesh", "ellipsoid_mesh", "star_blob", "stretched_blob", "bent_blob"]
 
@@ -28,9 +28,11 @@ def test_every_shape_is_bijective_c1_and_close(shape):
     # is the bent blob's (the others are within 0.01)
     assert report.distance["hausdorff"] < (0.05 if shape == "bent_blob" else 0.01), report.distance
     folds = [w for w in caught if "folds over" in str(w.message)]
-    assert bool(folds) == (report.folded > FOLDED_WARNING)
+    # the build warns on the check's count (level FOLD_LEVEL, away from the cut vertices)
+    assert bool(folds) == (report.folds["fraction"] > FOLDED_WARNING)
+    assert report.folds["level"] == FOLD_LEVEL and report.folds["triangles"] == 2 * (2 ** FOLD_LEVEL * 32) ** 2
     if shape != "bent_blob":
-        assert report.folded < FOLDED_WARNING, report.folded
+        assert report.folds["fraction"] < FOLDED_WARNING, report.folds
 
 
 def test_folds_are_reported_and_warned():

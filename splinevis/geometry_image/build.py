@@ -24,8 +24,8 @@ from .fit import fit_geometry_image
 from .measure import surface_distance
 from .model import GeometryImage
 
-__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "FOLDED_WARNING",
-           "AUTO_SIZES", "AUTO_HAUSDORFF"]
+__all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "fold_counts",
+           "FOLDED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,9 +53,16 @@ class BuildReport:
     orientation : (3, 3) ndarray
         The rotation of the sphere the mesh was sampled through.
     folded : float
-        Fraction of the measured limit mesh's triangles that face against the surface normals at their corners
-        (:func:`folded_fraction`): ripples folding over where the parametrization undersamples the mesh; NaN
-        when not measured.
+        The build's own count: fraction of the triangles of the limit mesh it measures the distance on
+        (``levels_finer`` levels down) that face against the surface normals at their corners
+        (:func:`folded_fraction`, the cut vertices' triangles included); NaN when not measured. A coarse level
+        overstates the folds: a triangle across which the surface bends sharply flips without a fold.
+    folds : dict
+        The check's count (:mod:`.judge`), measured the same way: ``{"level", "triangles", "folded",
+        "fraction", "at_cut"}`` of the limit mesh :data:`FOLD_LEVEL` levels down (:func:`fold_counts`:
+        neighbouring limit points whose normals and triangle turn apart, the triangles at the four cut vertices
+        counted apart in ``at_cut``); empty when not measured. :data:`FOLDED_WARNING` applies to its
+        ``fraction``.
     repairs : tuple of str
         What was done to the input to make it one closed triangle mesh (:func:`.repair.prepare_mesh`: welding,
         triangulating, dropping unused points); each also a warning.
@@ -80,10 +87,16 @@ class BuildReport:
     folded: float = float("nan")
     orientation: np.ndarray = field(default_factory=lambda: np.eye(3))
     repairs: tuple = ()
+    folds: dict = field(default_factory=dict)
 
 
-#: Above this fraction of folded limit triangles, :func:`geometry_image_from_mesh` warns.
-FOLDED_WARNING = 1e-3
+#: Above this fraction of folded limit triangles on level :data:`FOLD_LEVEL` (the check's count, away from the
+#: cut vertices), :func:`geometry_image_from_mesh` warns and the check fails (:mod:`.judge` says why 1e-4).
+FOLDED_WARNING = 1e-4
+
+#: The subdivision level folds are counted on, by the build and the check alike: the check draws level 3 and
+#: measures one level finer (:mod:`.judge`).
+FOLD_LEVEL = 4
 
 
 def folded_fraction(points, normals, faces) -> float:
@@ -99,6 +112,50 @@ def folded_fraction(points, normals, faces) -> float:
     P, N, F = (np.asarray(a) for a in (points, normals, faces))
     orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
     return float((np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0).mean())
+
+
+def fold_counts(points, normals) -> tuple:
+    """``(folded, at_cut)``: how many triangles of the ``M x M`` grid of limit ``points`` with unit ``normals``
+    (both ``(M, M, 3)``; triangles as :func:`.subdivision.grid_faces` makes them) face against the sum of the
+    normals at their corners, away from the four cut vertices and touching one of them. The same test as
+    :func:`folded_fraction`, on the grid's slices instead of an index array (a level-4 grid of a 257 x 257
+    image has 33 million triangles); the triangles at the cut vertices, where the tangents vanish, are
+    counted apart (:mod:`.judge`).
+
+    >>> import numpy as np
+    >>> i, j = np.mgrid[0:9, 0:9].astype(float)
+    >>> P = np.stack([j, i, 0.0 * i], axis=2); up = np.broadcast_to([0.0, 0.0, 1.0], P.shape)
+    >>> fold_counts(P, up), fold_counts(P, -up)  # a flat 9 x 9 grid: its 128 triangles all fold when lit from below
+    ((0, 0), (116, 12))
+    """
+    from .image import cut_vertices
+
+    P, N = np.asarray(points), np.asarray(normals)
+    M = P.shape[0]
+    folded = 0
+    for rows in range(0, M - 1, 512):  # in bands of rows: the cross products of a band at a time
+        r = slice(rows, min(rows + 512, M - 1))
+        r1 = slice(rows + 1, min(rows + 513, M))
+        a, b, c, d = P[r, :-1], P[r, 1:], P[r1, :-1], P[r1, 1:]
+        na, nb, nc, nd = N[r, :-1], N[r, 1:], N[r1, :-1], N[r1, 1:]
+        up = np.einsum("ijk,ijk->ij", np.cross(b - a, d - a), na + nb + nd) < 0.0  # (00, 01, 11)
+        lo = np.einsum("ijk,ijk->ij", np.cross(d - a, c - a), na + nd + nc) < 0.0  # (00, 11, 10)
+        folded += int(up.sum() + lo.sum())
+    at_cut = 0
+    for vr, vc in cut_vertices(M):  # the up-to-six triangles around each cut vertex
+        for cr in (vr - 1, vr):
+            for cc in (vc - 1, vc):
+                if not (0 <= cr < M - 1 and 0 <= cc < M - 1):
+                    continue
+                a, b, c, d = P[cr, cc], P[cr, cc + 1], P[cr + 1, cc], P[cr + 1, cc + 1]
+                na, nb, nc, nd = N[cr, cc], N[cr, cc + 1], N[cr + 1, cc], N[cr + 1, cc + 1]
+                corners_up = {(cr, cc), (cr, cc + 1), (cr + 1, cc + 1)}
+                corners_lo = {(cr, cc), (cr + 1, cc + 1), (cr + 1, cc)}
+                if (vr, vc) in corners_up and np.cross(b - a, d - a) @ (na + nb + nd) < 0.0:
+                    at_cut += 1
+                if (vr, vc) in corners_lo and np.cross(d - a, c - a) @ (na + nd + nc) < 0.0:
+                    at_cut += 1
+    return folded - at_cut, at_cut
 
 
 def limit_mesh_arrays(image: GeometryImage, level: int):
@@ -247,11 +304,23 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness: float = 0.1, oversampl
                 break
     if len(sizes) > 1:
         distance["sizes_tried"] = tried
+    folds = {}
     if measure:
-        if folded > FOLDED_WARNING:
+        t0 = time.perf_counter()
+        from .subdivision import subdivide
+
+        sub = subdivide(fit.image.control, FOLD_LEVEL)
+        count, at_cut = fold_counts(sub.p, sub.n)
+        del sub
+        triangles = 2 * (2 ** FOLD_LEVEL * (int(n) - 1)) ** 2
+        folds = {"level": FOLD_LEVEL, "triangles": triangles, "folded": count, "fraction": count / triangles,
+                 "at_cut": at_cut}
+        seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
+        if folds["fraction"] > FOLDED_WARNING:
             import warnings
 
-            warnings.warn(f"the geometry image of {name} folds over in {100 * folded:.2g}% of its limit triangles: the "
+            warnings.warn(f"the geometry image of {name} folds over in {100 * folds['fraction']:.2g}% of its limit "
+                          f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}): the "
                           f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
                           f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; a larger n "
                           "or fairness reduces the ripples.", stacklevel=2)
@@ -264,5 +333,5 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness: float = 0.1, oversampl
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
-                         stretch, distance, fit.rms, folded, R, tuple(repairs))
+                         stretch, distance, fit.rms, folded, R, tuple(repairs), folds)
     return fit.image, report

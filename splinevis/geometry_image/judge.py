@@ -48,10 +48,16 @@ into the 30 degree view: the 300 pixel height spans ``diagonal / cos 15 deg``, s
 * Any folded limit triangle: WARN. A fold is a visible shading defect (a crease that catches the light
   wrongly) wherever the camera comes close. Folded triangles on the drawn level only: WARN too, because
   they are drawn facing against the normals they are lit with.
-* Folded limit triangles above 1e-3 of all: FAIL. The threshold is :data:`.build.FOLDED_WARNING`, the one the
-  build warns at. A fold's crease flips a handful of triangles at any level (0 to 20 for a 5 x 5 block of a
-  17 x 17 image turned over, at levels 1 to 4), so 1e-3 of the 2 million triangles of a
-  65 x 65 image at level 4 means a hundred folds or more: the whole surface ripples.
+* Folded limit triangles above 1e-4 of all: FAIL. The threshold is :data:`.build.FOLDED_WARNING`, the one the
+  build warns at (the build counts the same way on the same level, :data:`.build.FOLD_LEVEL`). A fold's crease
+  flips a handful of triangles at any level (0 to 20 for a 5 x 5 block of a 17 x 17 image turned over, at
+  levels 1 to 4), and a ripple crossing one control cell flips about one row of its ``16 x 16`` level-4 quads,
+  ~32 triangles. So 1e-4 of the ``2 (16 (n - 1))^2`` level-4 triangles is ``1.6e-3 (n - 1)^2`` cells crossed,
+  about a hundred of the 65,536 cells of a 257 x 257 image: a few short ripples in a few places, each a
+  shading defect seen close up (WARN), while at 1e-3 (the former threshold) a thousand cells ripple, scattered
+  over the whole of a limb. The check reports the build's own count beside its own (every triangle, the cut
+  vertices' included, on the build's level 2, where a coarse triangle across a sharp bend flips without a fold:
+  an upper bound).
 * Normals reversed at more than 1e-3 of the surface: FAIL. That is four control cells of a 65 x 65 image
   (4 / 64^2) turned inside out, a patch several pixels across shaded from behind. Any reversed point: WARN.
 
@@ -80,6 +86,10 @@ THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FO
 
 #: The level whose limit points the reversed normals are counted on (module docstring).
 REVERSED_LEVEL = 2
+
+#: The level of the build's own fold count (``levels_finer`` of :func:`.build.geometry_image_from_mesh`),
+#: reported beside the check's.
+BUILD_FOLD_LEVEL = 2
 
 
 
@@ -148,15 +158,12 @@ def _input_arrays(mesh):
     return V, F
 
 
-def _folds(P, N, T, M):
+def _folds(P, N, M):
     """``(folded, at_cut)``: triangles turned against the normals at their corners, away from the four cut
-    vertices and at them, of the ``M x M`` grid ``P, N, T``."""
-    from .image import cut_vertices
+    vertices and at them, of the ``M x M`` grid of limit points ``P`` and normals ``N`` (:func:`.build.fold_counts`)."""
+    from .build import fold_counts
 
-    orient = np.cross(P[T[:, 1]] - P[T[:, 0]], P[T[:, 2]] - P[T[:, 0]])
-    folded = np.einsum("ij,ij->i", orient, N[T].sum(axis=1)) < 0.0
-    at_cut = np.isin(T, cut_vertices(M) @ np.array([M, 1])).any(axis=1)
-    return int((folded & ~at_cut).sum()), int((folded & at_cut).sum())
+    return fold_counts(P.reshape(M, M, 3), N.reshape(M, M, 3))
 
 
 def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = None) -> dict:
@@ -173,7 +180,7 @@ def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = 
     >>> m["limit_triangles"], m["folded_triangles"], m["drawn_folded"], bool(m["hausdorff"] < 0.03)
     (8192, 0, 0, True)
     """
-    from .build import limit_mesh_arrays
+    from .build import folded_fraction, limit_mesh_arrays
     from .measure import surface_distance
     from .subdivision import grid_faces
 
@@ -181,7 +188,7 @@ def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = 
     P, N, T = limit_mesh_arrays(model, measure_level)
     M = int(round(math.sqrt(len(P))))
     out = dict(surface_distance(P, T, V, F))
-    folded, at_cut = _folds(P, N, T, M)
+    folded, at_cut = _folds(P, N, M)
     out.update(measure_level=int(measure_level), limit_triangles=int(len(T)), folded_triangles=folded,
                folded_fraction=folded / len(T), cut_vertex_folded=at_cut)
     drawn = max(int(measure_level) - 1, 0) if drawn_level is None else min(int(drawn_level), int(measure_level))
@@ -189,7 +196,14 @@ def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = 
     Md = (M - 1) // step + 1
     Pd = P.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
     Nd = N.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
-    out.update(drawn_level=drawn, drawn_folded=_folds(Pd, Nd, grid_faces(Md), Md)[0])
+    out.update(drawn_level=drawn, drawn_folded=_folds(Pd, Nd, Md)[0])
+    # the build's own count (BuildReport.folded): every triangle, the cut vertices' included, on its level
+    bl = min(BUILD_FOLD_LEVEL, int(measure_level))
+    step = 1 << (int(measure_level) - bl)
+    Mb = (M - 1) // step + 1
+    Pb = P.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
+    Nb = N.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
+    out.update(build_fold_level=bl, build_folded_fraction=folded_fraction(Pb, Nb, grid_faces(Mb)))
     out.update(_reversed(P, N, M, int(measure_level), V, F))
     out.update(input_vertices=int(len(V)), input_triangles=int(len(F)), n=int(model.n))
     return out
@@ -243,7 +257,9 @@ def _accuracy(path, data: MeshData, model, baseline, options, findings) -> dict:
 
     folds, frac, rev = m["folded_triangles"], m["folded_fraction"], m["reversed_fraction"]
     fold = (f"{folds:,} of the {m['limit_triangles']:,} limit triangles at level {m['measure_level']} turn against "
-            f"the surface normals at their corners (not counting {m['cut_vertex_folded']} at the cut vertices), and "
+            f"the surface normals at their corners ({100 * frac:.3g} %; not counting {m['cut_vertex_folded']} at the "
+            f"cut vertices; the build's count, every triangle at level {m['build_fold_level']}: "
+            f"{100 * m['build_folded_fraction']:.3g} %), and "
             f"the normals point into the mesh at {m['reversed_points']:,} of {m['reversed_grid_points']:,} limit "
             f"points ({100 * rev:.3g} % of the surface)")
     note = ""

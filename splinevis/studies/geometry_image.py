@@ -20,10 +20,19 @@ GPU) against what users have today.
   exact surface; the largest vertex motion per 1/8 level (geomorphs: no pops).
 * **(f) Displacement**: the distance of the limit points to the input mesh before and after a displacement
   map at each level.
+* **(g) Real meshes** (:mod:`splinevis.studies.geometry_image_real`): the seven closed genus-0 meshes of the data
+  folder beside the repository (``../shared/data/meshes``; absent: the section says so and is skipped), each
+  built with ``n="auto"``: triangles in, the size chosen, stretch, distance to the input, folds, seconds per
+  stage; at equal triangle counts the image at the drawn level 3 against MeshLab's Loop and Catmull-Clark
+  subdivisions of the input (distance, normal error against the input's interpolated vertex normals, folds,
+  time); a row of reflection-line renders per mesh (input, Loop, Catmull-Clark, image; one camera).
+  ``quick`` skips it.
 * Figures (:mod:`splinevis.studies.geometry_image_figures`): the pipeline (mesh, sphere, octahedron, image,
-  smooth surface, reflection lines), error against triangles, fairness, levels of detail.
+  smooth surface, reflection lines), error against triangles, fairness, levels of detail, and section (g)'s
+  reflection lines.
 
-The full run takes a few minutes, ``quick`` well under one.
+Sections (a)-(f) take a few minutes, ``quick`` well under one; section (g) about 20 to 40 minutes more (seven
+builds of 10k-100k triangles and subdivisions of up to 17 million triangles, up to 5 GB of memory).
 """
 
 from __future__ import annotations
@@ -313,6 +322,10 @@ def _markdown(result) -> str:
     md.append(md_table(result["displacement"], [
         ("level", "level", "s"), ("samples", "samples", "int"), ("before max", "before_max", "e"),
         ("after max", "after_max", "e"), ("before RMS", "before_rms", "e"), ("after RMS", "after_rms", "e")]))
+    if "real" in result:
+        from .geometry_image_real import real_mesh_markdown
+
+        md.append(real_mesh_markdown(result["real"]))
     return "".join(md)
 
 
@@ -340,11 +353,20 @@ def run_geometry_image_study(out_dir, *, quick=False, progress=True) -> dict:
     result["fairness"] = _fairness(s, progress)
     log("geometry-image", "(e) levels of detail, (f) displacement")
     result["lod"], result["displacement"], image = _lod(s, progress)
+    if quick:
+        result["real"] = {"available": None, "skipped": True,
+                          "note": "quick runs skip the real meshes (the full run builds all seven)."}
+    else:
+        from .geometry_image_real import real_mesh_section
+
+        log("geometry-image", "(g) real meshes")
+        result["real"] = real_mesh_section(out, progress=progress)
     log("geometry-image", "figures")
     result["figures"] = [p.name for p in (pipeline_figure(out / "geometry-image_pipeline.png", quick=quick),
                                           accuracy_figure(out / "geometry-image_accuracy.png", result["accuracy"]),
                                           fairness_figure(out / "geometry-image_fairness.png", result["fairness"]),
                                           lod_figure(out / "geometry-image_lod.png", image, result["lod"]))]
+    result["figures"] += result["real"].get("figures", [])
     result["seconds"] = time.perf_counter() - t0
     (out / "geometry-image.md").write_text(_markdown(result))
     write_json(out / "geometry-image.json", result)

@@ -8,7 +8,7 @@ import numpy as np
 
 from .report import pyplot, save_figure
 
-__all__ = ["pipeline_figure", "accuracy_figure", "fairness_figure", "lod_figure", "render"]
+__all__ = ["pipeline_figure", "accuracy_figure", "fairness_figure", "lod_figure", "reflection_row_figure", "render"]
 
 CAMERA = [(5.0, -6.5, 4.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
 
@@ -196,3 +196,27 @@ def lod_figure(path, image, rows, levels=None):
     ax.set_ylabel("max distance to the exact blob")
     ax.grid(True, which="both", alpha=0.3)
     return save_figure(fig, path, dpi=90)
+
+
+def reflection_row_figure(path, shots, title: str):
+    """One row of renders ``shots`` (``(title, image)`` pairs, the same camera for all) under ``title``: the real
+    meshes of section (g), each surface with the same reflection lines.
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> shots = [(f"panel {i}", np.full((20, 20, 3), 60 * i, np.uint8)) for i in range(3)]
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     reflection_row_figure(Path(d) / "r.png", shots, "three panels").stat().st_size > 0
+    True
+    """
+    plt = pyplot()
+    fig, axes = plt.subplots(1, len(shots), figsize=(4.6 * len(shots), 5.0), squeeze=False)
+    for ax, (label, image) in zip(axes[0], shots):
+        ax.imshow(image)
+        ax.set_title(label, fontsize=10)
+        ax.axis("off")
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.94))  # room for the title above the panels' own
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
