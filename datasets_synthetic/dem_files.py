@@ -51,10 +51,30 @@ def _i6(v: int) -> str:
     return s
 
 
+def _i6_bytes(values) -> bytes:
+    """Right-justified I6 fields of the integers ``values``, concatenated (vectorized: a 3000 x 3000 DEM's nine
+    million fields in a second)."""
+    v = np.asarray(values, dtype=np.int64).ravel()
+    a = np.abs(v)
+    width = np.maximum(1, np.floor(np.log10(np.maximum(a, 1))).astype(np.int64) + 1) + (v < 0)
+    if (width > 6).any():
+        bad = v[np.argmax(width > 6)]
+        raise ValueError(f"{bad} does not fit the DEM's 6-character integer field.")
+    out = np.full((v.size, 6), ord(" "), dtype=np.uint8)
+    for p in range(6):  # column p holds the digit of 10^(5 - p)
+        digit = (a // 10 ** (5 - p)) % 10
+        shown = p >= 6 - width + (v < 0)
+        out[:, p] = np.where(shown, 48 + digit, out[:, p])
+    neg = np.flatnonzero(v < 0)
+    out[neg, 6 - width[neg]] = ord("-")
+    return out.tobytes()
+
+
 def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, utm_zone: int = 33,
                          label: str = "splinevis synthetic DEM", clip_profiles: bool = False,
-                         corners=None) -> Path:
-    """Write a minimal USGS ASCII DEM (planimetric system UTM, metres in x, y and z).
+                         corners=None, geographic: bool = False, horizontal_datum: int | None = 3,
+                         vertical_datum: int | None = 3, accuracy=None, line_breaks: bool = False) -> Path:
+    """Write a USGS ASCII DEM (records A, B and, with ``accuracy``, C; metres in z).
 
     Parameters
     ----------
@@ -62,14 +82,15 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
     heights : (ny, nx) array_like
         Rows south to north; NaN becomes the void value -32767.
     spacing : (dx, dy) floats > 0
-        Written as E12.6: 7 significant digits.
+        Written as E12.6: 7 significant digits. Metres, or arc-seconds when ``geographic``.
     origin : (x0, y0)
-        South-west sample; corners are written as D24.15 (16 significant digits).
+        South-west sample; corners are written as D24.15 (16 significant digits). Metres (UTM), or
+        arc-seconds of longitude and latitude when ``geographic``.
     z_resolution : float, optional
         Elevations are stored as integers times this. Default: the finest of 0.001, 0.01, ..., 100
         that keeps every integer within the 6-character field (-99999 .. 999999).
     utm_zone : int
-        Zone written in the header (metadata only; the coordinates need not be real UTM).
+        Zone written in the header (the coordinates need not be real UTM); ignored when ``geographic``.
     label : str
         First 144 characters of the header.
     clip_profiles : bool
@@ -79,6 +100,18 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
     corners : four (x, y) pairs, optional
         Quadrangle corners SW, NW, NE, SE for the header (need not lie on the sample lattice).
         Default: the corner samples.
+    geographic : bool
+        Planimetric system 0 (geographic), x and y in arc-seconds (as the USGS 1-degree DEMs), instead of
+        system 1 (UTM) in metres.
+    horizontal_datum, vertical_datum : int or None
+        Codes of the type A record's columns 891-892 (1 NAD 27, 2 WGS 72, 3 WGS 84, 4 NAD 83) and 889-890
+        (1 local mean sea level, 2 NGVD 29, 3 NAVD 88); None leaves them blank, as files made before these
+        fields existed do.
+    accuracy : ten ints, optional
+        The type C (accuracy) record's fields: datum RMSE available (0/1), RMSE x, y, z, sample size, then the
+        same for the DEM; written after the profiles, with the type A accuracy code 1.
+    line_breaks : bool
+        End every 1024-character block with a line break (as some distributions do).
 
     Returns
     -------
@@ -88,10 +121,21 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
     -----
     Layout: a 1024-character type A record, then one type B record per column (profile), each
     padded to 1024-character blocks (146 elevations in the first block, 170 in each further one),
-    elevations south to north. ``vtkDEMReader`` computes the number of columns/rows from the corners
-    in float32, so origin and extent should be exact in float32 (e.g. whole metres); this writer
-    refuses values for which VTK would count differently. Also, VTK 9.7.1's reader crashes (division
-    by zero) on DEMs with fewer than 100 columns; :func:`splinevis.io.read_heights` parses those itself.
+    elevations south to north, then the optional type C record in one block. ``vtkDEMReader`` computes
+    the number of columns/rows from the corners in float32, so origin and extent should be exact in
+    float32 (e.g. whole metres); this writer refuses values for which VTK would count differently. Also,
+    VTK 9.7.1's reader crashes (division by zero) on DEMs with fewer than 100 columns;
+    :func:`splinevis.io.read_heights` parses those itself.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = write_usgs_ascii_dem(Path(folder) / "a.dem", [[1, 2], [3, 4]], 30.0, (5e5, 5e6),
+    ...                                 accuracy=(0,) * 10)
+    ...     text = path.read_text()
+    >>> len(text), text[156:168], text[888:892], text[810:816]  # A + 2 profiles + C; UTM 33; datums; code
+    (4096, '     1    33', ' 3 3', '     1')
     """
     h, (dx, dy), (x0, y0) = _check_grid(heights, spacing, origin)
     ny, nx = h.shape
@@ -105,6 +149,8 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
             raise ValueError(f"heights up to {big} do not fit a DEM's integer field even at z_resolution 100.")
     if not (math.isfinite(z_resolution) and z_resolution > 0):
         raise ValueError(f"z_resolution must be finite and > 0, got {z_resolution!r}.")
+    if accuracy is not None and len(accuracy) != 10:
+        raise ValueError(f"accuracy must be the type C record's ten integers, got {len(accuracy)}.")
     k = np.where(np.isfinite(h), np.rint(np.nan_to_num(h) / z_resolution), DEM_VOID).astype(np.int64)
     if (np.isfinite(h) & (k == DEM_VOID)).any():
         raise ValueError(f"a height rounds to the void value {DEM_VOID} * z_resolution; change z_resolution.")
@@ -120,15 +166,19 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
     zmin, zmax = float(valid.min()) * z_resolution, float(valid.max()) * z_resolution
 
     a = label[:144].ljust(144)
-    a += _i6(1) + _i6(1) + _i6(1) + _i6(utm_zone)  # level 1, regular pattern, UTM, zone
-    a += "".join(_d24(0.0) for _ in range(15))  # projection parameters (unused for UTM)
-    a += _i6(2) + _i6(2) + _i6(4)  # plane unit metres, elevation unit metres, 4 sides
+    system, zone, unit = (0, 0, 3) if geographic else (1, utm_zone, 2)  # arc-seconds or metres
+    a += _i6(1) + _i6(1) + _i6(system) + _i6(zone)  # level 1, regular pattern, planimetric system, zone
+    a += "".join(_d24(0.0) for _ in range(15))  # projection parameters (unused for UTM and geographic)
+    a += _i6(unit) + _i6(2) + _i6(4)  # plane unit, elevation unit metres, 4 sides
     for cx, cy in corners or ((x0, y0), (x0, yn), (xe, yn), (xe, y0)):  # SW, NW, NE, SE
         a += _d24(cx) + _d24(cy)
-    a += _d24(zmin) + _d24(zmax) + _d24(0.0) + _i6(0)  # elevation bounds, rotation, accuracy code
+    a += _d24(zmin) + _d24(zmax) + _d24(0.0) + _i6(0 if accuracy is None else 1)  # bounds, rotation, accuracy
     a += "".join(f"{v:12.6E}" for v in (dx, dy, z_resolution))
     a += _i6(1) + _i6(nx)  # rows (1 for a regular DEM), columns = number of profiles
-    records = [a.ljust(1024)]
+    a += " " * 24  # 865-888: contour intervals, dates, flags (blank)
+    a += "  " if vertical_datum is None else f"{int(vertical_datum):2d}"
+    a += "  " if horizontal_datum is None else f"{int(horizontal_datum):2d}"
+    records = [a.ljust(1024).encode("ascii")]
     for i in range(nx):
         col, j0 = k[:, i], 0
         if clip_profiles:
@@ -139,13 +189,13 @@ def write_usgs_ascii_dem(path, heights, spacing, origin, *, z_resolution=None, u
         lo_hi = (float(good.min()) * z_resolution, float(good.max()) * z_resolution) if good.size else (0.0, 0.0)
         head = _i6(1) + _i6(i + 1) + _i6(col.size) + _i6(1)
         head += _d24(x0 + i * dx) + _d24(y0 + j0 * dy) + _d24(0.0) + _d24(lo_hi[0]) + _d24(lo_hi[1])
-        cells = [_i6(v) for v in col]
-        blocks = [head + "".join(cells[:146])]
-        for s in range(146, col.size, 170):
-            blocks.append("".join(cells[s:s + 170]))
-        records.extend(b.ljust(1024) for b in blocks)
+        cells = _i6_bytes(col)
+        records.append((head.encode("ascii") + cells[:6 * 146]).ljust(1024))
+        records.extend(cells[s:s + 6 * 170].ljust(1024) for s in range(6 * 146, len(cells), 6 * 170))
+    if accuracy is not None:
+        records.append(_i6_bytes(accuracy).ljust(1024))
     path = Path(path)
-    path.write_bytes("".join(records).encode("ascii"))
+    path.write_bytes((b"\n" if line_breaks else b"").join(records) + (b"\n" if line_breaks else b""))
     return path
 
 

@@ -1,11 +1,15 @@
 """splinevis.io.read_heights: every reader round-trips exact reference values; bad input fails clearly."""
 
+import warnings
+
 import numpy as np
 import pytest
 import pyvista as pv
+import rasterio
 
 from datasets_synthetic.dem_files import DEM_VOID, fractal_terrain, write_usgs_ascii_dem
 from splinevis.io import HeightGrid, read_heights
+from splinevis.io.dem import looks_like_usgs_dem, read_dem_records
 
 UTM = (5e5, 5.1e6)
 
@@ -238,7 +242,7 @@ def test_usgs_dem_round_trip(tmp_path, nx):
     path = write_usgs_ascii_dem(tmp_path / "t.dem", h, (30.0, 10.0), UTM, z_resolution=0.01)
     g = read_heights(path)
     assert g.shape == (ny, nx) and g.spacing == (30.0, 10.0) and g.origin == UTM
-    assert g.crs == "UTM zone 33 (x, y in m)" and g.units == "m"
+    assert g.crs == "EPSG:32633" and g.units == "m"  # UTM zone 33 on the WGS 84 datum the header names
     assert np.abs(g.heights - h).max() <= 0.005 + 1e-9
     # exactly the stored integers times the resolution
     np.testing.assert_array_equal(g.heights, np.rint(h / 0.01) * 0.01)
@@ -321,6 +325,99 @@ def test_usgs_dem_where_gdal_fails_our_parser_gives_the_known_answer(tmp_path):
 def test_dem_writer_refuses_float32_inexact_geometry(tmp_path):
     with pytest.raises(ValueError, match=r"vtkDEMReader would count .* samples in x"):
         write_usgs_ascii_dem(tmp_path / "x.dem", np.zeros((3, 200)), (0.1, 1.0), (5e5 + 0.05, 5.1e6))
+
+
+@pytest.mark.parametrize("line_breaks", [False, True])
+def test_usgs_dem_type_c_record_and_line_breaks(tmp_path, line_breaks):
+    # A DEM that ends with a type C (accuracy) record, whose type A record says so (accuracy code 1): the
+    # record is read, not taken for one more profile; some distributions end every 1024-character block
+    # with a line break: same values.
+    h = 300.0 + plane(150, 160, 10.0, 10.0)  # 160 elevations: two blocks per profile
+    acc = (1, 2, 3, 4, 28, 1, 0, 0, 7, 30)
+    path = write_usgs_ascii_dem(tmp_path / "c.dem", h, 10.0, UTM, z_resolution=0.01, accuracy=acc,
+                                line_breaks=line_breaks)
+    assert (b"\n" in path.read_bytes()) == line_breaks
+    g = read_heights(path)
+    np.testing.assert_array_equal(g.heights, np.rint(h / 0.01) * 0.01)
+    assert g.origin == UTM and g.crs == "EPSG:32633"
+    dem = read_dem_records(path)
+    assert dem.header["accuracy_code"] == 1 and tuple(dem.accuracy.values()) == acc
+    assert dem.accuracy["dem_rmse_z"] == 7 and dem.header["vertical_datum"] == 3
+
+
+def test_usgs_dem_more_profiles_than_the_header_is_an_error(tmp_path):
+    # What follows the announced profiles must be a type C record; a 4th profile after a header announcing
+    # 3 means the header or the file is wrong: said, never dropped or taken for accuracy figures.
+    path = write_usgs_ascii_dem(tmp_path / "four.dem", 100.0 + plane(4, 5), 1.0, (0.0, 0.0))
+    data = bytearray(path.read_bytes())
+    data[858:864] = b"     3"  # the number of profiles, columns 859-864 of the type A record
+    path.write_bytes(bytes(data))
+    with pytest.raises(ValueError, match=r"four\.dem: after the profiles the header announces, the file holds "
+                                         r"[\d,]+ more characters that are not a type C"):
+        read_heights(path)
+
+
+def test_usgs_dem_malformed_elevation_names_profile_and_byte(tmp_path):
+    path = write_usgs_ascii_dem(tmp_path / "bad.dem", 100.0 + plane(4, 5), 1.0, (0.0, 0.0), z_resolution=1.0)
+    data = bytearray(path.read_bytes())
+    at = 1024 + 2 * 1024 + 144 + 6 * 2  # profile 3, its third elevation
+    data[at:at + 6] = b"  1x2 "
+    path.write_bytes(bytes(data))
+    with pytest.raises(ValueError, match=rf"bad\.dem: malformed type B .*field '  1x2 ' of profile 3 at byte {at}"):
+        read_heights(path)
+
+
+def test_usgs_dem_named_tif_is_read_by_content(tmp_path):
+    # A DEM named .tif went to GDAL's USGSDEM driver, which snaps the origin to multiples of the spacing
+    # (10 m off here) and invents a row; by content it reaches our parser: every sample at its place.
+    h = 200.0 + plane(8, 6, 30.0, 30.0)
+    x0, y0 = 500010.0, 5100020.0
+    dem = write_usgs_ascii_dem(tmp_path / "a.dem", h, 30.0, (x0, y0), z_resolution=0.01)
+    tif = tmp_path / "really_a_dem.tif"
+    tif.write_bytes(dem.read_bytes())
+    g = read_heights(tif)
+    assert g.shape == (6, 8) and g.origin == (x0, y0) and g.crs == "EPSG:32633"
+    np.testing.assert_array_equal(g.heights, read_heights(dem).heights)
+    assert not looks_like_usgs_dem(write_usgs_ascii_dem.__code__.co_filename)  # a Python file is not a DEM
+
+
+@pytest.mark.parametrize("datum, epsg", [(1, 4267), (3, 4326), (4, 4269), (None, None)])
+def test_usgs_dem_geographic_in_arc_seconds(tmp_path, datum, epsg):
+    # USGS 1-degree DEMs: planimetric system 0, x and y in arc-seconds (3 arc-seconds apart); read in degrees
+    # with the geographic CRS of the header's horizontal datum (NAD 27, WGS 84, NAD 83).
+    lon0, lat0 = -113.0 * 3600, 37.0 * 3600
+    h = 1500.0 + plane(5, 4, 3.0, 3.0)
+    path = write_usgs_ascii_dem(tmp_path / "geo.dem", h, 3.0, (lon0, lat0), z_resolution=1.0, geographic=True,
+                                horizontal_datum=datum)
+    if datum is None:  # no datum code: NAD 27 as GDAL assumes it, and said
+        with pytest.warns(UserWarning, match=r"geo\.dem: the type A record names no horizontal datum .* NAD 27 "
+                                             r"assumed \(EPSG:4267\)"):
+            dem = read_dem_records(path)
+        epsg = 4267
+    else:
+        dem = read_dem_records(path)
+    assert dem.origin == (-113.0, 37.0) and dem.spacing == (3.0 / 3600, 3.0 / 3600)
+    assert dem.crs == f"EPSG:{epsg}"
+    with rasterio.open(path) as ds:  # GDAL's USGSDEM driver: same CRS
+        assert ds.crs.to_epsg() == epsg
+    np.testing.assert_array_equal(dem.elevations, np.rint(h).astype(int))
+
+
+def test_usgs_dem_utm_crs_from_datum(tmp_path):
+    h = 100.0 + plane(3, 3)
+    for datum, zone, crs in ((1, 12, "EPSG:26712"), (4, 17, "EPSG:26917"), (3, -19, "EPSG:32719"),
+                             (2, 5, "EPSG:32205"), (None, 12, "EPSG:26712")):
+        path = write_usgs_ascii_dem(tmp_path / "u.dem", h, 1.0, UTM, utm_zone=zone, horizontal_datum=datum)
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            assert read_dem_records(path).crs == crs, (datum, zone)
+        with rasterio.open(path) as ds:  # GDAL's USGSDEM driver reads the same datum and zone
+            assert ds.crs.to_epsg() == int(crs[5:]), (datum, zone)
+    path = write_usgs_ascii_dem(tmp_path / "sp.dem", h, 1.0, UTM, utm_zone=12)
+    data = bytearray(path.read_bytes())
+    data[156:162] = b"     2"  # state plane: no EPSG from the header alone, a description
+    path.write_bytes(bytes(data))
+    assert read_dem_records(path).crs == "state plane zone 12, WGS 84 (x, y in m)"
 
 
 # GeoTIFF and the other rasters read through rasterio/GDAL: tests/test_io_raster.py

@@ -6,7 +6,8 @@
 * a pyvista ``ImageData`` (or ``vtkImageData``) that is one x-y slice, ``dims == (nx, ny, 1)``,
 * a pyvista ``RectilinearGrid`` or ``StructuredGrid`` whose x, y coordinates form an axis-aligned lattice,
 * a file: ``.vti .vtk .vtr .vts`` (through :func:`pyvista.read`), ``.dem`` (USGS ASCII DEM, our own
-  parser: see :mod:`.dem` for what GDAL's driver gets wrong) and, through rasterio/GDAL (see
+  parser: see :mod:`.dem` for what GDAL's driver gets wrong; a USGS DEM is recognized by its content
+  whatever its extension, so one named ``.tif`` does not go to GDAL) and, through rasterio/GDAL (see
   :mod:`.raster`), ``.tif .tiff`` (GeoTIFF/COG), ``.hgt`` (SRTM), ``.asc`` (ESRI ASCII grid), ``.img``,
   ``.bil``, ``.dt0 .dt1 .dt2`` (DTED), ``.grd``, ``.vrt``; a file with any other extension is tried
   with GDAL too.
@@ -47,7 +48,7 @@ from .._validation import as_float64_array, check_choice
 from ._common import (VTK_FILES, check_geometry, first_gap, freeze_grid, gap_error, nonuniform_message,
                       refuse_own_geometry, require_regular_file, source_kind, step_deviation,
                       unsupported_extension)
-from .dem import read_dem
+from .dem import looks_like_usgs_dem, read_dem
 from .height_interp import fill_gaps, resample_uniform
 from .height_samples import GEOMETRY_ARGS_APPLY_TO, HeightSamples, from_array
 from .height_vtk import from_pyvista, read_vtk_file
@@ -295,6 +296,9 @@ def _dispatch(source, *, scalars, spacing, origin, nodata, band) -> HeightSample
 def _read_file(path: Path, *, scalars, spacing, origin, nodata, band) -> HeightSamples:
     ext = path.suffix.lower()
     require_regular_file(path, "height")
+    if ext not in VTK_FILES and ext != ".dem" and looks_like_usgs_dem(path):
+        # by content, whatever the name: GDAL's USGSDEM driver would snap the origin (module notes of .dem)
+        ext = ".dem"
     if ext in VTK_FILES or ext == ".dem":
         refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
         if band != 1:

@@ -116,9 +116,13 @@ def reader_against_file(path, grid, band: int = 1) -> dict | None:
     pixel = np.array([abs(affine.a), abs(affine.e)])  # file pixel (x, y) in the grid's units, unless reprojected
     if crs is not None and grid.crs is not None:
         from rasterio.crs import CRS
+        from rasterio.errors import CRSError
         from rasterio.warp import transform
 
-        target = CRS.from_user_input(grid.crs)
+        try:
+            target = CRS.from_user_input(grid.crs)
+        except CRSError:  # a description the reader gave (a DEM header's state plane zone): the file's own units
+            target = CRS.from_user_input(crs)
         if CRS.from_user_input(crs) != target:
             k = len(x) // 2  # the file's pixel measured in the grid's CRS at a sample in the middle
             px, py = transform(crs, target, [x[k], x[k] + abs(affine.a), x[k]], [y[k], y[k], y[k] + abs(affine.e)])
