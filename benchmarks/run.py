@@ -24,6 +24,8 @@ Cases
   (``bench_outofcore.py``): wall time, tiles/s at 1 and 2 workers, disk and peak memory of a fresh process.
 * ``nurbs_files``: many-face CAD models (real STEP/IGES files when ``../shared/data/nurbs`` is there, synthetic
   ones always) from the file to the first frame, stage by stage, in fresh processes (``bench_nurbs_files.py``).
+* ``read_dem``: a 3000 x 3000 USGS ASCII DEM read by ``read_heights`` beside GDAL's USGSDEM driver and the same
+  heights as GeoTIFF (``bench_read_dem.py``; 800 x 800 with ``--quick``).
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -257,6 +259,10 @@ def _markdown(results):
         from bench_nurbs_files import nurbs_files_markdown
 
         lines.append(nurbs_files_markdown(results["nurbs_files"]))
+    if "read_dem" in results:
+        from bench_read_dem import read_dem_markdown
+
+        lines.append(read_dem_markdown(results["read_dem"]))
     return "\n".join(lines) + "\n"
 
 
@@ -278,12 +284,14 @@ def main(argv=None):
     from bench_nurbs_files import bench_nurbs_files
     from bench_outofcore import bench_outofcore
     from bench_profile import bench_profile
+    from bench_read_dem import bench_read_dem
     from bench_scale import bench_cold_start, bench_large_terrain
 
     cases = [("raycast_vs_mesh", bench_raycast_vs_mesh), ("effect_sets", bench_effect_sets), ("terrain", bench_terrain),
              ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
              ("profile", bench_profile), ("mesh_guided", bench_mesh_guided), ("outofcore", bench_outofcore),
-             ("nurbs_files", bench_nurbs_files)]
+             ("nurbs_files", bench_nurbs_files),
+             ("read_dem", lambda repeats, quick: bench_read_dem(800 if quick else 3000, min(repeats, 3)))]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

@@ -357,14 +357,24 @@ def test_usgs_dem_more_profiles_than_the_header_is_an_error(tmp_path):
         read_heights(path)
 
 
-def test_usgs_dem_malformed_elevation_names_profile_and_byte(tmp_path):
+@pytest.mark.parametrize("field", [b"  1x2 ", b" 12 34", b"-  123", b"   12-", b"  +-12", b"      "])
+def test_usgs_dem_malformed_elevation_names_profile_and_byte(tmp_path, field):
     path = write_usgs_ascii_dem(tmp_path / "bad.dem", 100.0 + plane(4, 5), 1.0, (0.0, 0.0), z_resolution=1.0)
     data = bytearray(path.read_bytes())
     at = 1024 + 2 * 1024 + 144 + 6 * 2  # profile 3, its third elevation
-    data[at:at + 6] = b"  1x2 "
+    data[at:at + 6] = field
     path.write_bytes(bytes(data))
-    with pytest.raises(ValueError, match=rf"bad\.dem: malformed type B .*field '  1x2 ' of profile 3 at byte {at}"):
+    with pytest.raises(ValueError, match=rf"bad\.dem: malformed type B .*field '{field.decode().replace('+', '[+]')}' "
+                                         rf"of profile 3 at byte {at}"):
         read_heights(path)
+
+
+def test_usgs_dem_signed_and_padded_fields(tmp_path):
+    # right-justified I6 with a sign, and -99999 (the most negative five digits): exact stored integers
+    h = np.array([[-99999.0, -5.0, 0.0], [7.0, -32766.0, 999999.0]])
+    path = write_usgs_ascii_dem(tmp_path / "s.dem", h, 1.0, (0.0, 0.0), z_resolution=1.0)
+    assert b"-99999     7" in path.read_bytes() and b"    -5-32766" in path.read_bytes()  # profiles are columns
+    np.testing.assert_array_equal(read_dem_records(path).elevations, h.astype(int))
 
 
 def test_usgs_dem_named_tif_is_read_by_content(tmp_path):

@@ -219,20 +219,25 @@ def _cells(count: int) -> np.ndarray:
 
 def _parse_i6(buf: np.ndarray, starts: np.ndarray):
     """Integers of the right-justified I6 fields of ``buf`` at ``starts``: ``(values, bad)``, ``bad`` the index
-    of the first field that is not ``spaces, optional sign, digits`` (None when all are). Vectorized: the
-    fields are cut by column, so six-digit elevations that touch ("100000100700") read right."""
-    F = buf[starts[:, None] + np.arange(6)]
-    digit = (F >= 48) & (F <= 57)
-    space = F == 32
-    sign = (F == 45) | (F == 43)
-    first = np.argmax(~space, axis=1)  # first character that is not a space (0 for an empty field)
-    rows = np.arange(len(F))
-    after = np.arange(6)[None, :] > first[:, None]
-    ok = (digit[rows, first] | sign[rows, first]) & digit[:, 5] & (digit | ~after).all(axis=1)
-    lead = F[rows, first]
-    bad = None if ok.all() else int(np.argmin(ok))
-    values = np.where(digit, F.astype(np.int64) - 48, 0) @ (10 ** np.arange(5, -1, -1, dtype=np.int64))
-    return np.where(lead == 45, -values, values), bad
+    of the first field that is not ``spaces, optional sign, digits`` (None when all are). Vectorized, one column
+    of the six at a time (no ``(N, 6)`` temporaries): the fields are cut by column, so six-digit elevations
+    that touch ("100000100700") read right."""
+    values = np.zeros(len(starts), dtype=np.int64)
+    started = np.zeros(len(starts), dtype=bool)
+    bad = np.zeros(len(starts), dtype=bool)
+    neg = np.zeros(len(starts), dtype=bool)
+    for c in range(6):
+        ch = buf[starts + c]
+        d = ch - np.uint8(48)  # wraps for characters below '0'
+        digit = d <= 9
+        space = ch == 32
+        sign = (ch == 45) | (ch == 43)
+        bad |= ~(digit | space | sign) | ((space | sign) & started)  # a space or sign after the number began
+        started |= ~space
+        neg |= ch == 45
+        values = np.where(digit, values * 10 + d, values)
+    bad |= ~digit  # the last character is a digit
+    return np.where(neg, -values, values), (int(np.argmax(bad)) if bad.any() else None)
 
 
 def _fixed_width_profiles(path: Path, buf: np.ndarray, nprofiles: int):
