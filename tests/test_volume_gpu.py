@@ -60,7 +60,7 @@ def test_isovalue_outside_the_data_raises_with_the_range_in_add_isosurface_and_s
     pl = splinevis.Plotter(off_screen=True, window_size=(80, 60))
     for iso_value in (5.0, -1.0):
         with pytest.raises(ValueError, match=rf"isovalue={iso_value!r} lies outside the volume's data range "
-                                             rf"\[{lo!r}, {hi!r}\].*Pass an isovalue inside that range"):
+                                             rf"\[{lo!r}, {hi!r}\] and the spline.s .*Pass an isovalue inside the spline.s range"):
             pl.add_isosurface(sphere_grid(), iso_value)
     actor = pl.add_isosurface(sphere_grid(), 0.7)
     with pytest.raises(ValueError, match=r"isovalue=5\.0 lies outside"):

@@ -327,23 +327,53 @@ def raycast_world(model: Isosurface, origins, directions, tmin=0.0, **options):
 
 
 def check_isovalue_in_range(surface: Isosurface, what: str = "isovalue") -> None:
-    """Raise ValueError when the isosurface is empty because the isovalue lies outside the data range.
+    """No blank picture without a word: raise or warn when the isosurface is empty or may be
+    (:func:`splinevis.volume.isovalue_range.isovalue_verdict`).
 
-    An isovalue outside ``[min, max]`` of the samples whose spline still reaches it (an overshoot of
-    the spline between samples) is drawn; only an empty one raises. The message gives the range and
-    what to do. (An empty :class:`Isosurface` built directly stays allowed: ``add_spline`` draws nothing.)
+    * Proven empty with the isovalue outside the data's ``[min, max]``: ValueError giving the data's and the
+      spline's range and what to do. (An isovalue outside the samples' range that the spline still reaches,
+      an overshoot between samples, is drawn.)
+    * Proven empty inside the data's range (the spline smooths the data's peak below it), or not proven
+      non-empty (no vertex value beyond the isovalue: an isovalue at the data's extreme, a surface that may be
+      empty, a few points or tiny bubbles): a warning with the spline's range and the options
+      (``prefilter="interpolate"`` makes the spline reach the samples).
+
+    An empty :class:`Isosurface` built directly stays allowed: ``add_spline`` draws nothing.
 
     >>> from splinevis.volume.hard_cases import sphere_grid
     >>> check_isovalue_in_range(Isosurface(VolumeSpline(sphere_grid(6)), 9.0))
     Traceback (most recent call last):
-    ValueError: isovalue=9.0 lies outside the volume's data range [...]: the isosurface is empty (a blank picture). Pass an isovalue inside that range, e.g. its middle ...
+    ValueError: isovalue=9.0 lies outside the volume's data range [...] and the spline's [...]: the isosurface is empty (a blank picture). Pass an isovalue inside the spline's range, e.g. ...
     """
-    lo, hi = (float(v) for v in surface.spline.value_range)
-    iso = surface.isovalue
-    if not lo <= iso <= hi and len(surface.relevant.cubes) == 0:
-        raise ValueError(f"{what}={iso!r} lies outside the volume's data range [{lo!r}, {hi!r}]: the isosurface is "
-                         f"empty (a blank picture). Pass an isovalue inside that range, e.g. its middle "
-                         f"{0.5 * (lo + hi)!r}.")
+    from .._warnings import warn_user
+    from .isovalue_range import coefficient_range, isovalue_verdict
+
+    v = isovalue_verdict(surface)
+    if v.status == "non-empty":
+        return
+    lo, hi = v.data_range
+    clo, chi = coefficient_range(surface.spline)
+    iso = v.isovalue
+    source = surface.spline.grid.source
+    spline_range = (f"the spline's values lie within [{clo:.6g}, {chi:.6g}] (the range of its BB coefficients, "
+                    "which bounds it)")
+    options = ("prefilter='interpolate' makes the spline pass through the samples (it reaches the data's range); "
+               f"or pass an isovalue inside [{clo:.6g}, {chi:.6g}], e.g. {0.5 * (clo + chi):.6g}")
+    if v.status == "empty" and not lo <= iso <= hi:
+        raise ValueError(f"{what}={iso!r} lies outside the volume's data range [{lo!r}, {hi!r}] and the spline's "
+                         f"[{clo:.6g}, {chi:.6g}]: the isosurface is empty (a blank picture). Pass an isovalue "
+                         f"inside the spline's range, e.g. its middle {0.5 * (clo + chi):.6g}.")
+    at_extreme = " (the data's extreme)" if iso in (lo, hi) else ""
+    if v.status == "empty":
+        msg = (f"{source}: {what}={iso!r} lies inside the data's range [{lo:.6g}, {hi:.6g}]{at_extreme} but outside "
+               f"what the spline reaches: {spline_range}, smoothing the data's extremes: the isosurface is empty "
+               f"and the picture blank. {options}.")
+    else:
+        vlo, vhi = v.vertex_range
+        msg = (f"{source}: the isosurface {what}={iso!r}{at_extreme} may be empty, a few points or tiny bubbles: the "
+               f"spline's values at the vertices of the {v.tetrahedra} tetrahedra that could hold it lie in "
+               f"[{vlo:.6g}, {vhi:.6g}], not on both sides of it, and {spline_range}. {options}.")
+    warn_user(msg)
 
 
 def attach_culling(actor, plotter, *, culling: bool = True) -> None:
