@@ -117,6 +117,10 @@ class IsovalueVerdict:
     there are none; when proven non-empty, of the tetrahedra checked until the proof); ``tetrahedra``: how many
     can hold it. ``coefficient_range`` is computed only when not proven non-empty (else NaN): it costs the
     coefficients of the cubes near the extremes.
+
+    >>> v = IsovalueVerdict(0.9, "empty", (0.0, 1.0), (0.0, 0.78), (float("nan"),) * 2, 0)
+    >>> v.status, v.isovalue > v.coefficient_range[1]  # above everything the spline reaches
+    ('empty', True)
     """
 
     isovalue: float
