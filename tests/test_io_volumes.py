@@ -507,6 +507,61 @@ def test_cube_file_errors_name_the_file_and_the_fix(tmp_path):
         read_volume(p, spacing=(1, 1, 1))
 
 
+def test_cube_axes_orthogonal_to_the_printed_decimals_read_in_their_frame(tmp_path):
+    # A rotated lattice of 0.1 Bohr steps printed with 6 decimals (Gaussian's %12.6f): each entry within
+    # 5e-7 of the true step, so the unit axes are orthogonal only to ~1e-5; refused before as a shear
+    # (tolerance 1e-6). Read at the file's precision: drawn in its true frame, the correction reported.
+    from splinevis.io.volume_samples import unit_rounding
+
+    R = _rotation(0.3, 0.9, -0.5)
+    steps = 0.1 * R  # columns: the step vectors
+    printed = np.round(steps, 6)
+    unit = printed / np.linalg.norm(printed, axis=0)
+    assert np.abs(unit.T @ unit - np.eye(3)).max() > 1e-6  # what the former fixed tolerance refused
+    a = values_of("float64", (3, 3, 3))
+    data = " ".join(repr(float(v)) for v in np.transpose(a, (2, 1, 0)).ravel())
+    axes = "\n".join(f"3 {printed[0, c]:12.6f}{printed[1, c]:12.6f}{printed[2, c]:12.6f}" for c in range(3))
+    (tmp_path / "rot.cube").write_text(f"c\nc\n1 0.0 0.0 0.0\n{axes}\n8 0.0 0.0 0.0 0.0\n{data}\n")
+    with pytest.warns(UserWarning, match=r"rot\.cube: the lattice axes are orthonormal only to the precision the "
+                                         r"source carries \(deviation .*, tolerance .* derived from the precision "
+                                         r"the source prints\); drawn with the nearest orthonormal matrix"):
+        r = read_volume(tmp_path / "rot.cube")
+    assert np.array_equal(r.values, a) and r.is_rotated
+    D = np.asarray(r.direction)
+    assert np.abs(D.T @ D - np.eye(3)).max() < 1e-15  # exactly orthonormal to rounding
+    # the polar factor Q of R + E (R orthogonal) is within 2 |E|_F of R; |E|_F from the printed digits
+    e = np.asarray(unit_rounding(printed, [5e-7] * 3))
+    assert np.abs(D - R).max() <= 2 * np.sqrt((e ** 2).sum())
+    # a shear of 1e-3 is still a shear at this precision
+    sheared = printed.copy()
+    sheared[:, 1] += 1e-4 * printed[:, 0] / 0.1
+    axes = "\n".join(f"3 {sheared[0, c]:12.6f}{sheared[1, c]:12.6f}{sheared[2, c]:12.6f}" for c in range(3))
+    (tmp_path / "shear6.cube").write_text(f"c\nc\n1 0.0 0.0 0.0\n{axes}\n8 0.0 0.0 0.0 0.0\n{data}\n")
+    with pytest.raises(ValueError, match=r"shear6\.cube: the direction matrix .* not orthonormal .* beyond the "
+                                         r"tolerance .* derived from the precision the source prints"):
+        read_volume(tmp_path / "shear6.cube")
+
+
+def test_nrrd_space_directions_judged_at_the_printed_precision(tmp_path):
+    # an LPS volume of 0.9 mm voxels on a rotated lattice, its space directions printed with 4 decimals (as
+    # many scanners' exports do): orthogonal to ~1e-4 only; read in its frame with the correction reported
+    R = _rotation(0.2, -0.4, 0.7)
+    printed = np.round(0.9 * R, 4)
+    unit = printed / np.linalg.norm(printed, axis=0)
+    assert np.abs(unit.T @ unit - np.eye(3)).max() > 1e-6  # refused before (fixed tolerance 1e-6)
+    dirs = " ".join("(" + ",".join(f"{v:.4f}" for v in printed[:, c]) + ")" for c in range(3))
+    hdr = (f"NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 2 2 2\n"
+           f"space directions: {dirs}\nspace origin: (1,2,3)\nencoding: raw\nendian: little\n\n")
+    (tmp_path / "rot.nrrd").write_bytes(hdr.encode() + np.arange(8, dtype="<f4").tobytes())
+    with pytest.warns(UserWarning, match=r"rot\.nrrd: the lattice axes are orthonormal only to the precision"):
+        r = read_volume(tmp_path / "rot.nrrd")
+    D = np.asarray(r.direction)
+    assert np.abs(D.T @ D - np.eye(3)).max() < 1e-15 and r.spacing == pytest.approx((0.9,) * 3, abs=1e-4)
+    # each unit column within 2 sqrt(3) 5e-5 / 0.9 of R's (module notes of volume_samples); the polar factor
+    # within twice the Frobenius norm of that error
+    assert np.abs(D - R).max() <= 2 * np.sqrt(3) * (2 * np.sqrt(3) * 5e-5 / 0.9)
+
+
 # ---- stacks of raw slices -------------------------------------------------------------------------------
 def test_folder_and_glob_of_raw_slices_read_as_one_volume_in_natural_order(tmp_path):
     from datasets_synthetic.volume_files import write_slices

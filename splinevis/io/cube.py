@@ -14,8 +14,12 @@ vectors: a rotated lattice silently loses its orientation. The format is simple 
 * the samples, first axis slowest, third axis fastest (``data[i1][i2][i3]``), any number per line.
 
 The three step vectors must be orthogonal (a rotated orthogonal lattice); their lengths become the
-spacing and their directions the columns of ``VolumeGrid.direction``. A sheared lattice raises
-ValueError. With several values per point (``nval > 1``, e.g. several orbitals) ``component=`` picks one.
+spacing and their directions the columns of ``VolumeGrid.direction``. Orthogonal is judged at the precision
+the file prints: writers print the vectors with a fixed number of decimals (6 with Gaussian's ``%12.6f``), so
+the vectors of a rotated lattice are orthogonal only to within half a unit of their last digit; the tolerance
+is derived from those digits (:func:`.volume_samples.orthonormal_direction`), the matrix replaced by the
+nearest orthonormal one and the correction reported in a warning. A sheared lattice (beyond that tolerance)
+raises ValueError. With several values per point (``nval > 1``, e.g. several orbitals) ``component=`` picks one.
 """
 
 from __future__ import annotations
@@ -24,7 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .volume_samples import VolumeSamples, check_size, orthonormal_direction, pick_component
+from .volume_samples import (VolumeSamples, check_size, orthonormal_direction, pick_component, printed_rounding,
+                             unit_rounding)
 
 __all__ = ["read_cube"]
 
@@ -82,13 +87,14 @@ def read_cube(path: Path, scalars=None, component=None) -> VolumeSamples:
     head = _numbers(lines[2], path, 3, "natoms ox oy oz [nval]", 4)
     natoms, origin = int(head[0]), tuple(head[1:4])
     nval = int(head[4]) if len(head) > 4 else 1
-    counts, steps = [], []
+    counts, steps, printed = [], [], []
     for a in range(3):
         n, *vec = _numbers(lines[3 + a], path, 4 + a, f"the sample count and step vector of axis {a + 1}", 4)
         if int(n) == 0:
             raise ValueError(f"{path}: line {4 + a}: axis {a + 1} has 0 samples; a volume needs at least 2.")
         counts.append(abs(int(n)))
         steps.append(np.asarray(vec[:3], dtype=np.float64))
+        printed += lines[3 + a].split()[1:4]
     pos = 6 + abs(natoms)
     if len(lines) < pos:
         raise ValueError(f"{path}: the header announces {abs(natoms)} atoms but the file ends after {len(lines)} "
@@ -123,6 +129,9 @@ def read_cube(path: Path, scalars=None, component=None) -> VolumeSamples:
     lengths = [float(np.linalg.norm(v)) for v in steps]
     if min(lengths) == 0.0:
         raise ValueError(f"{path}: an axis step vector is zero: {[v.tolist() for v in steps]}.")
-    direction = orthonormal_direction(np.column_stack([v / L for v, L in zip(steps, lengths)]), str(path))
+    # orthogonal to the decimals the file prints (module notes): judged at that precision
+    direction = orthonormal_direction(np.column_stack([v / L for v, L in zip(steps, lengths)]), str(path),
+                                      rounding=unit_rounding(np.column_stack(steps),
+                                                             printed_rounding(printed).reshape(3, 3).max(axis=1)))
     return VolumeSamples(values=values, spacing=tuple(lengths), origin=tuple(float(o) for o in origin),
                          source=str(path), direction=direction)

@@ -27,7 +27,7 @@ import numpy as np
 
 from .raw import with_byteorder
 from .volume_samples import (VolumeSamples, axis_signs, check_samples, check_size, orthonormal_direction,
-                             pick_component)
+                             pick_component, printed_rounding, unit_rounding)
 
 __all__ = ["read_nrrd"]
 
@@ -264,7 +264,13 @@ def _geometry(path: Path, f: dict, sp_dirs, keep: list, ndim: int, sizes: list) 
             axis_signs(unit, str(path))
             step = np.diag(m).copy()
         except ValueError:  # rotated orthogonal axes are kept as a direction; a shear raises here
-            rotation = orthonormal_direction(unit, str(path))
+            # judged at the precision the header prints its space directions (half a unit of the last digit)
+            printed = [hit.group(1).split(",") for hit in _NRRD_VECTOR.finditer(f["space directions"])
+                       if hit.group(0) != "none"]
+            rounding = None
+            if len(printed) == 3 and all(len(v) == 3 for v in printed):
+                rounding = unit_rounding(m, printed_rounding(sum(printed, [])).reshape(3, 3).max(axis=1))
+            rotation = orthonormal_direction(unit, str(path), rounding=rounding)
             step = lengths.copy()
         origin = np.zeros(3)
         if "space origin" in f:

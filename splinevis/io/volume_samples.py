@@ -16,7 +16,7 @@ import numpy as np
 from ._common import check_exact_in_float64, check_real_dtype
 
 __all__ = ["VolumeSamples", "GEOMETRY_ARGS_APPLY_TO", "check_samples", "check_size", "pick_component", "from_array",
-           "axis_signs", "orthonormal_direction"]
+           "axis_signs", "orthonormal_direction", "printed_rounding", "unit_rounding"]
 
 #: The sources ``spacing=``/``origin=`` are meant for (the others carry their own geometry).
 GEOMETRY_ARGS_APPLY_TO = "numpy arrays and raw files"
@@ -273,11 +273,65 @@ def axis_signs(direction: np.ndarray, where: str) -> np.ndarray:
                      "orientation does not matter.")
 
 
-def orthonormal_direction(direction, where: str) -> tuple:
+def printed_rounding(texts) -> np.ndarray:
+    """Bounds on how far the values that the decimal numbers ``texts`` (printed by one writer) stand for can be
+    from what they print.
+
+    Two kinds of writers: **fixed decimals** (``%12.6f``: every entry shows the same ``D >= 2`` decimals,
+    trailing zeros kept) are within half a unit of the last decimal, ``0.5 10^-D``; **trimmed** output
+    (``%g``, shortest round-trip ``repr``: decimals vary, trailing zeros dropped, so ``"1"`` may stand for
+    ``1.00000``) is within half a unit of the ``S``-th significant digit, ``S`` the most significant digits any
+    entry shows and at least 6 (C's ``%g`` default: no writer prints fewer for a direction). One decimal
+    everywhere (``"1.0"``, ``"0.5"``) is read as trimmed: it is what Python's ``repr`` prints for such values,
+    and no writer of directions prints one fixed decimal.
+
+    >>> printed_rounding(["0.707107", "-0.004998", "0.000000"]).tolist()  # fixed, 6 decimals
+    [5e-07, 5e-07, 5e-07]
+    >>> printed_rounding(["1", "0.5", "0"]).tolist()  # trimmed: 6 significant digits assumed
+    [5e-06, 5e-07, 0.0]
+    >>> bool(printed_rounding(["0.7071067811865476", "-0.7071067811865475", "0"])[0] < 1e-16)  # repr
+    True
+    """
+    decimals, digits, exponents = [], [], []
+    for text in texts:
+        t = text.strip().lower().replace("d", "e")
+        mantissa, _, exponent = t.partition("e")
+        whole, _, frac = mantissa.lstrip("+-").partition(".")
+        sig = (whole + frac).lstrip("0")
+        decimals.append(len(frac) - int(exponent or 0))
+        digits.append(len(sig) if sig else 0)
+        value = float(t)
+        exponents.append(np.floor(np.log10(abs(value))) if value != 0 else None)
+    if len(set(decimals)) == 1 and decimals[0] >= 2 and len(texts) > 1:
+        return np.full(len(texts), 0.5 * 10.0 ** -decimals[0])
+    S = max(max(digits), 6)
+    return np.array([0.0 if e is None else 0.5 * 10.0 ** (e - S + 1) for e in exponents])
+
+
+def unit_rounding(steps, rounding) -> tuple:
+    """Bounds on the error (Euclidean norm) of each unit column ``v / |v|`` of the step vectors ``steps``
+    (columns) whose entries are each within ``rounding`` (per column) of the true ones: a perturbation ``e``
+    of ``v`` moves ``v / |v|`` by at most ``2 |e| / |v|``, and ``|e| <= sqrt(3) rounding``.
+
+    >>> unit_rounding(np.eye(3) * 0.2, [5e-7] * 3)[0]  # a 0.2 step printed with 6 decimals
+    8.660254037844385e-06
+    """
+    m = np.asarray(steps, dtype=np.float64)
+    lengths = np.linalg.norm(m, axis=0)
+    return tuple(float(2.0 * np.sqrt(3.0) * r / L) for r, L in zip(np.broadcast_to(rounding, (3,)), lengths))
+
+
+def orthonormal_direction(direction, where: str, *, rounding=None) -> tuple:
     """``direction`` as a 3 x 3 nested tuple of floats whose columns are orthonormal; else ValueError.
 
-    Columns are re-orthonormalised (entries within ``1e-6`` of an orthonormal matrix pass; the result is
-    exactly orthonormal to rounding). A shear, non-unit or non-orthogonal axis raises.
+    The columns are judged at the precision the source carries: ``rounding`` bounds the error (Euclidean
+    norm) ``e_i`` of each unit column as read (:func:`unit_rounding` of the printed decimals, or of float32
+    storage); true orthonormal columns then have Gram entries ``|u_i . u_j - delta_ij| <= e_i + e_j + e_i
+    e_j``, and the largest of those plus 16 float64 rounding units is the tolerance. ``None`` (a matrix in
+    memory of unknown provenance): 1e-6. Within it the matrix is replaced by the nearest orthonormal one
+    (the orthogonal polar factor ``U V^T`` of its SVD, nearest in the Frobenius norm); when that moves an entry by more than float64
+    rounding, a warning reports the deviation, the tolerance and the correction. A shear, non-unit or
+    non-orthogonal axis beyond the tolerance raises.
 
     Parameters
     ----------
@@ -285,6 +339,8 @@ def orthonormal_direction(direction, where: str) -> tuple:
         Columns: the world direction of the lattice axes x, y, z.
     where : str
         The source, for the message.
+    rounding : float or (3,) floats, optional
+        Per column: bound on the error of the unit column as read.
 
     Examples
     --------
@@ -292,18 +348,33 @@ def orthonormal_direction(direction, where: str) -> tuple:
     (1.0, 0.0, 0.0)
     >>> orthonormal_direction([[1, 0.5, 0], [0, 1, 0], [0, 0, 1]], "a.cube")
     Traceback (most recent call last):
-    ValueError: a.cube: the direction matrix [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] is not orthonormal (a shear or non-orthogonal axes, deviation 0.5); only rotated orthogonal lattices are drawn. Resample onto an orthogonal lattice first (e.g. scipy.ndimage.map_coordinates).
+    ValueError: a.cube: the direction matrix [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] is not orthonormal (a shear or non-orthogonal axes, deviation 0.5 beyond the tolerance 1e-06); only rotated orthogonal lattices are drawn. Resample onto an orthogonal lattice first (e.g. scipy.ndimage.map_coordinates).
     """
     d = np.asarray(direction, dtype=np.float64)
     if d.shape != (3, 3) or not np.isfinite(d).all():
         raise ValueError(f"{where}: direction matrix {np.asarray(direction).tolist()} is not a finite 3 x 3 matrix "
                          "(columns: world direction of the lattice axes x, y, z).")
+    if rounding is None:
+        tol, how = 1e-6, ""
+    else:
+        e = np.broadcast_to(np.asarray(rounding, dtype=np.float64), (3,))
+        tol = float((e[:, None] + e[None, :] + e[:, None] * e[None, :]).max()) + 16 * 2.0 ** -53
+        how = " derived from the precision the source prints"
     dev = float(np.abs(d.T @ d - np.eye(3)).max())
-    if dev > 1e-6:
+    if dev > tol:
         raise ValueError(f"{where}: the direction matrix {np.round(d, 12).tolist()} is not orthonormal (a shear or "
-                         f"non-orthogonal axes, deviation {dev:.3g}); only rotated orthogonal lattices are drawn. "
-                         "Resample onto an orthogonal lattice first (e.g. scipy.ndimage.map_coordinates).")
+                         f"non-orthogonal axes, deviation {dev:.3g} beyond the tolerance {tol:.3g}{how}); only "
+                         "rotated orthogonal lattices are drawn. Resample onto an orthogonal lattice first "
+                         "(e.g. scipy.ndimage.map_coordinates).")
     if dev > 0:
         u, _, vt = np.linalg.svd(d)
-        d = u @ vt
+        q = u @ vt
+        moved = float(np.abs(q - d).max())
+        if moved > 64 * 2.0 ** -53:
+            from .._warnings import warn_user
+
+            warn_user(f"{where}: the lattice axes are orthonormal only to the precision the source carries "
+                      f"(deviation {dev:.3g}, tolerance {tol:.3g}{how}); drawn with the nearest orthonormal matrix, "
+                      f"whose entries differ from the source's by at most {moved:.3g}.")
+        d = q
     return tuple(tuple(float(x) for x in row) for row in d)
