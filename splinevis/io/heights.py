@@ -199,8 +199,10 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
         1-based band of a raster file read through GDAL (:mod:`.raster`).
     crs : str, optional
         A grid in a geographic CRS (degrees) is reprojected to a local metric CRS: by default the UTM
-        zone of its centre (reported in ``source``), or this projected CRS (``"EPSG:32632"``). See
-        :mod:`.georef`.
+        zone of its centre, UPS when it reaches beyond 84 N / 80 S (reported in ``source``), or this projected
+        CRS (``"EPSG:32632"``). With ``fill=`` the new grid keeps all of the footprint (nodes outside it
+        filled as gaps), without it the largest north-up rectangle inside (the rest warned; a grid
+        reaching a polar cap then raises). See :mod:`.georef`.
     keep_geographic : bool
         Keep a geographic grid on its degree lattice instead, x and y scaled by the length of a degree
         at its centre latitude (stated in ``source``; true there only).
@@ -247,10 +249,10 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
         origin = check_geometry(origin, "origin", axes=2)
 
     samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, nodata=nodata, band=band)
-    return _georeference(_finish(samples, fill=fill, resample=resample), crs, keep_geographic, reproject)
+    return _georeference(_finish(samples, fill=fill, resample=resample), crs, keep_geographic, reproject, fill)
 
 
-def _georeference(grid: HeightGrid, crs, keep_geographic, reproject) -> HeightGrid:
+def _georeference(grid: HeightGrid, crs, keep_geographic, reproject, fill=None) -> HeightGrid:
     """A grid in a geographic CRS to metres (:mod:`.georef`); other grids as they are."""
     from .georef import is_geographic, scale_geographic, to_metric
 
@@ -265,10 +267,10 @@ def _georeference(grid: HeightGrid, crs, keep_geographic, reproject) -> HeightGr
     if keep_geographic and crs is not None:
         raise ValueError(f"{grid.source}: pass either crs= (reproject to that CRS) or keep_geographic=True, not both.")
     if keep_geographic:
-        m = scale_geographic(grid.heights, grid.spacing, grid.origin, grid.crs)
+        m = scale_geographic(grid.heights, grid.spacing, grid.origin, grid.crs, source=grid.source)
     else:
         m = to_metric(grid.heights, grid.spacing, grid.origin, grid.crs, target=crs, resampling=reproject,
-                      source=grid.source)
+                      source=grid.source, fill=fill)
     return HeightGrid(heights=m.heights, spacing=m.spacing, origin=m.origin, source=f"{grid.source}, {m.note}",
                       crs=m.crs, units=grid.units)
 

@@ -16,7 +16,8 @@ What is read
   (``flip_rows``); a south-up raster is kept. The error messages count rows and columns as stored.
   A rotated or sheared geotransform raises: warp the raster north-up first (gdalwarp).
 * ``crs`` is ``"EPSG:<code>"`` when GDAL finds an EPSG code, else the WKT, None without a CRS; either
-  string round-trips through ``rasterio.crs.CRS.from_user_input`` (e.g. to ask ``is_geographic``).
+  string round-trips through ``rasterio.crs.CRS.from_user_input`` (e.g. to ask ``is_geographic``). A
+  CRS PROJ cannot express so is a ValueError naming the file, not rasterio's CRSError.
   ``units`` is the band's unit (``"m"``, ``"ft"``) when GDAL knows it.
 * Missing: NaN/inf, the band's nodata value (``nodata=`` replaces it) and samples GDAL's mask band
   (per-dataset mask or alpha) marks invalid. A band scale/offset is applied (float64) after the gaps
@@ -67,11 +68,21 @@ def _gdal_message(exc: BaseException) -> str:
     return text.strip()
 
 
-def _crs_string(crs) -> str | None:
+def _crs_string(crs, path) -> str | None:
+    """``"EPSG:<code>"``, else the WKT, None without a CRS; a CRS PROJ cannot turn into either is our
+    ValueError naming the file (rasterio's CRSError never escapes)."""
+    import rasterio
+    from rasterio.errors import CRSError
+
     if crs is None:
         return None
-    epsg = crs.to_epsg()
-    return f"EPSG:{epsg}" if epsg else crs.to_wkt()
+    try:
+        with rasterio.Env():  # rasterio's error handler: PROJ's complaint in the exception, not on stderr
+            epsg = crs.to_epsg()
+            return f"EPSG:{epsg}" if epsg else crs.to_wkt()
+    except CRSError as exc:
+        raise ValueError(f"{path}: the file's CRS cannot be read ({exc}); set one PROJ knows, e.g. gdal_edit.py "
+                         f"-a_srs EPSG:32633 {Path(path).name}.") from None
 
 
 def read_raster(path, spacing=None, origin=None, nodata=None, band=1) -> HeightSamples:
@@ -167,7 +178,7 @@ def read_raster(path, spacing=None, origin=None, nodata=None, band=1) -> HeightS
                              "truncated or corrupt. Download or write it again.") from None
         file_nodata = ds.nodatavals[band - 1]
         scale, offset = ds.scales[band - 1], ds.offsets[band - 1]
-        crs, units = _crs_string(ds.crs), (ds.units[band - 1] or None)
+        crs, units = _crs_string(ds.crs, path), (ds.units[band - 1] or None)
     check_real_dtype(values, str(path), "heights")
     check_exact_in_float64(values, str(path))
     missing = missing_mask(values, file_nodata if nodata is None else nodata)
