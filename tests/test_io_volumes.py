@@ -416,8 +416,8 @@ def test_missing_empty_unsupported_and_corrupt_files_name_the_path(tmp_path):
         read_volume(tmp_path / "empty.mha")
     with pytest.raises(ValueError, match=r"x\.xyz: extension '\.xyz' is not supported"):
         read_volume(tmp_path / "x.xyz")
-    with pytest.raises(ValueError, match=r"NIfTI files are not read .* convert to NRRD"):
-        read_volume(tmp_path / "brain.nii")
+    with pytest.raises(ValueError, match=r"MINC files are not read .* convert to NIfTI \(\.nii\), NRRD"):
+        read_volume(tmp_path / "brain.mnc")
     with pytest.raises(ValueError, match="stack of headerless raw slices and needs shape= and dtype=.*DICOM series are not read"):
         read_volume(tmp_path)
     # MetaImage whose data are cut short: VTK only warns and returns garbage; we raise

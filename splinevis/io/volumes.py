@@ -20,17 +20,19 @@
   ``.slc``                  SLC (``vtkSLCReader``; 8-bit, no origin in the format)
   ``.raw`` ``.bin``         headerless samples: pass ``shape``, ``dtype``, ``byteorder``
   ``.cube``                 Gaussian cube (parsed here), rotated orthogonal lattice -> ``direction``
+  ``.nii`` ``.nii.gz``      NIfTI-1/-2 (nibabel), placed by the sform, else the qform, else ``pixdim``
   folder or glob            stack of raw slices (``shape=(ny, nx)``, ``dtype``, ``byteorder``)
   ========================  ===============================================================
 
 This module holds the result and the dispatch; the readers live in :mod:`.volume_vtk` (pyvista/VTK
-objects and the files VTK reads), :mod:`.nrrd` and :mod:`.raw`, each with its format notes, on the
-common checks of :mod:`.volume_samples`.
+objects and the files VTK reads), :mod:`.nrrd`, :mod:`.cube`, :mod:`.nifti` and :mod:`.raw`, each with its
+format notes, on the common checks of :mod:`.volume_samples`.
 
 Conventions kept by every reader
 --------------------------------
 * Samples are converted to float64 exactly (uint8 ... int32, float32, float64; int64/uint64 when
-  every value is below 2**53 in magnitude); ``VolumeGrid.dtype`` records the stored type.
+  every value is below 2**53 in magnitude); ``VolumeGrid.dtype`` records the stored type. A NIfTI file's
+  ``scl_slope``/``scl_inter`` are applied in float64 after the conversion and kept in ``VolumeGrid.rescale``.
 * Spacing may differ per axis; spacing and origin are kept in float64 as the source gives them
   (an origin of ``1e6`` with spacing ``1e3`` stays exact). Sources that carry their own geometry
   refuse ``spacing=``/``origin=`` rather than silently override it (SLC has no origin: ``origin=`` is
@@ -56,10 +58,12 @@ Conventions kept by every reader
 * **Slice stacks.** A folder of headerless slice files (or a glob such as ``"ct/s_*.raw"``) with
   ``shape=(ny, nx)``, ``dtype=``, ``byteorder=`` reads as one volume, the files sorted naturally by name
   (:mod:`.slices`).
-* **Rotated orthogonal lattices.** Gaussian cube files (``.cube``, :mod:`.cube`) keep their axes in
-  ``VolumeGrid.direction``; their spacing and origin are in the file's units (Bohr).
-* DICOM series and NIfTI are not read (VTK's readers ignore parts of their orientation); convert them
-  to NRRD or MetaImage first.
+* **Rotated orthogonal lattices.** Gaussian cube files (``.cube``, :mod:`.cube`), NRRD and NIfTI files
+  (:mod:`.nifti`) with rotated or permuted orthogonal axes keep them in ``VolumeGrid.direction``; spacing and
+  origin are in the file's units and its world frame (Bohr for cube files; NIfTI's RAS+ millimetres and the
+  NRRD ``space`` are kept as given, not converted into each other).
+* DICOM series, Analyze/NIfTI header-image pairs (``.hdr``/``.img``) and MINC are not read (VTK's readers
+  ignore parts of their orientation); convert them to NIfTI (``.nii``), NRRD or MetaImage first.
 """
 
 from __future__ import annotations
@@ -77,6 +81,7 @@ from ._common import (VTK_FILES, check_geometry, fill_nearest, first_gap, freeze
 from .nrrd import read_nrrd
 from .raw import read_raw
 from .cube import read_cube
+from .nifti import read_nifti
 from .slices import is_glob, read_slices
 from .volume_samples import GEOMETRY_ARGS_APPLY_TO, VolumeSamples, from_array, orthonormal_direction
 from .volume_vtk import from_pyvista, metaimage_direction, read_vtk_file
@@ -95,12 +100,20 @@ VOLUME_EXTENSIONS = {
     ".nhdr": "NRRD detached header (parsed by splinevis)",
     ".slc": "SLC (vtkSLCReader)",
     ".cube": "Gaussian cube, rotated orthogonal lattice (parsed by splinevis)",
+    ".nii": "NIfTI-1/-2, sform/qform placement (nibabel)",
+    ".nii.gz": "gzip-compressed NIfTI-1/-2, sform/qform placement (nibabel)",
     **dict.fromkeys(_RAW_EXTENSIONS, "headerless samples (shape=, dtype=, byteorder=)"),
 }
 _UNSUPPORTED = {
-    ".dcm": "DICOM", ".nii": "NIfTI", ".gz": "a compressed file (NIfTI .nii.gz?)", ".img": "Analyze/NIfTI",
-    ".hdr": "Analyze/NIfTI", ".mnc": "MINC",
+    ".dcm": "DICOM", ".gz": "gzip-compressed (other than .nii.gz)", ".img": "Analyze/NIfTI pair",
+    ".hdr": "Analyze/NIfTI pair", ".mnc": "MINC",
 }
+
+
+def _extension(path) -> str:
+    """The lower-case extension that names the format: ``.nii.gz`` for compressed NIfTI, else the suffix."""
+    name = Path(path).name.lower()
+    return ".nii.gz" if name.endswith(".nii.gz") else Path(name).suffix
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,8 +137,9 @@ class VolumeGrid:
         The data type of the source samples before conversion (``"uint8"``, ``"int16"``, ...).
     rescale : (slope, intercept)
         How the values relate to the stored samples: ``values = slope * stored + intercept`` (already
-        applied). ``(1.0, 0.0)`` for everything read from files; quantised synthetic samples
-        (``datasets_synthetic.volumes``) record their scale here.
+        applied). ``(1.0, 0.0)`` for files, except NIfTI files with a valid ``scl_slope`` (their
+        ``(scl_slope, scl_inter)``); quantised synthetic samples (``datasets_synthetic.volumes``) record their
+        scale here.
     direction : (3, 3) nested tuples, orthonormal columns
         World direction of the lattice axes x, y, z (the columns). Default: the identity. A rotated
         orthogonal lattice (e.g. a Gaussian cube file) has world point ``origin + direction @ (i*dx, j*dy,
@@ -285,7 +299,8 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
         None (default): NaN/inf samples raise ValueError. ``"nearest"``: fill each with the nearest valid
         voxel (world distance). A number: fill with that number.
     component : None, int or "magnitude"
-        For arrays with several components: pick one (0-based) or take the Euclidean norm.
+        For arrays with several components: pick one (0-based) or take the Euclidean norm. For a 4-D NIfTI
+        file (a series of volumes): the index of the volume to read (required there).
 
     Returns
     -------
@@ -335,9 +350,9 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
     is_path = isinstance(source, (str, os.PathLike))
     raw_args = {"shape": shape, "dtype": dtype, "byteorder": byteorder}
     stack = is_path and (is_glob(source) or Path(source).is_dir())
-    if not stack and (not is_path or Path(source).suffix.lower() not in _RAW_EXTENSIONS):
+    if not stack and (not is_path or _extension(source) not in _RAW_EXTENSIONS):
         given = [k for k, v in raw_args.items() if v is not None] + (["header_bytes"] if header_bytes else [])
-        if given and not (is_path and Path(source).suffix.lower() not in VOLUME_EXTENSIONS):
+        if given and not (is_path and _extension(source) not in VOLUME_EXTENSIONS):
             raise ValueError(f"{' and '.join(given)}= describe headerless raw files (.raw, .bin); "
                              f"{_describe(source)} carries that information itself. Drop the argument.")
 
@@ -381,10 +396,10 @@ def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, head
 
 def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes,
                component) -> VolumeSamples:
-    ext = path.suffix.lower()
+    ext = _extension(path)
     if ext in _UNSUPPORTED:
         raise ValueError(f"{path}: {_UNSUPPORTED[ext]} files are not read (VTK's readers ignore parts of their "
-                         "orientation); convert to NRRD (.nrrd) or MetaImage (.mha) first. Supported: "
+                         "orientation); convert to NIfTI (.nii), NRRD (.nrrd) or MetaImage (.mha) first. Supported: "
                          + ", ".join(VOLUME_EXTENSIONS) + ".")
     is_raw = ext in _RAW_EXTENSIONS or (ext not in VOLUME_EXTENSIONS and shape is not None)
     if not is_raw and ext not in VOLUME_EXTENSIONS:
@@ -400,6 +415,9 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
     if ext == ".cube":
         refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
         return read_cube(path, scalars, component)
+    if ext in (".nii", ".nii.gz"):
+        refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
+        return read_nifti(path, scalars, component)
     if ext in (".nrrd", ".nhdr"):
         refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
         return read_nrrd(path, scalars, component)
@@ -423,6 +441,9 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
 def _finish(samples: VolumeSamples, fill) -> VolumeGrid:
     src_dtype = np.dtype(samples.values.dtype)
     values = samples.oriented().astype(np.float64)
+    rescale = getattr(samples, "rescale", (1.0, 0.0))  # NIfTI scl_slope/scl_inter (read_nifti)
+    if rescale != (1.0, 0.0):
+        values = rescale[0] * values + rescale[1]
     bad = ~np.isfinite(values)
     n_bad, first = first_gap(bad, samples.source, "NaN/inf")
     if n_bad:
@@ -442,4 +463,4 @@ def _finish(samples: VolumeSamples, fill) -> VolumeGrid:
             values = np.where(bad, float(fill), values)
     dtype = src_dtype.name if src_dtype.kind != "b" else "bool"
     return VolumeGrid(values=values, spacing=samples.spacing, origin=samples.origin, source=samples.source,
-                      scalars=samples.scalars, dtype=dtype, direction=samples.direction)
+                      scalars=samples.scalars, dtype=dtype, direction=samples.direction, rescale=rescale)
