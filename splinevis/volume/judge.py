@@ -13,6 +13,10 @@
   quasi-interpolant (it reproduces linear functions, not the samples): reported, not judged. *Reader against
   VTK*: where VTK reads the file too, every sample must sit at the same world position (VTK's points, with the
   image's direction matrix) with the same value; a flipped axis, a wrong origin or a byte-swapped value is a FAIL.
+  Where VTK is known to read short (a compressed MetaImage whose header's ``CompressedDataSize`` is shorter than its
+  zlib stream: ``vtkMetaImageReader`` decodes the declared bytes only and leaves the other samples uninitialised),
+  those samples are compared with an independent zlib decode of the whole stream, and VTK's shortfall is a WARN
+  (:func:`_vtk_metaimage_shortfall`).
 
 Why our own code: the isovalue choice (scikit-image's Otsu) and the pairing of readings; the rest is the readers'.
 """
@@ -123,6 +127,9 @@ def _accuracy(path, grid, model, baseline, options, findings):
         return acc
     theirs = np.asarray(ds.point_data[name], dtype=np.float64)
     ours = np.asarray(grid.values, dtype=np.float64)
+    decoded = theirs.size
+    if str(path).lower().endswith((".mha", ".mhd")):
+        theirs, decoded = _vtk_metaimage_shortfall(path, np.asarray(ds.point_data[name]), theirs, findings)
     if theirs.size != ours.size:
         findings.append(Finding("FAIL", f"the reader gives {ours.size} samples {ours.shape}, VTK {theirs.size}"))
     else:
@@ -131,9 +138,74 @@ def _accuracy(path, grid, model, baseline, options, findings):
             findings.append(Finding("FAIL", f"the reader and VTK disagree at {bad} "
                                             f"samples of {ours.size}: {worst}"))
         else:
-            findings.append(Finding("PASS", f"reader matches VTK at all {ours.size} samples, placed in the world"))
+            findings.append(Finding("PASS", f"reader matches VTK at all {ours.size} samples, placed in the world"
+                                    if decoded == ours.size else f"reader matches VTK at the {decoded} samples VTK "
+                                    f"decodes and the whole stream's decode at the other {ours.size - decoded}, "
+                                    "placed in the world"))
     acc["reader_checked_against"] = "VTK"
     return acc
+
+
+def _metaimage_stream(path):
+    """An independent reading of a compressed MetaImage's data: ``(declared CompressedDataSize, stream bytes,
+    decode of the declared bytes, decode of the whole stream, byte order "<" or ">")`` or None (not compressed,
+    a slice list)."""
+    import re
+    import zlib
+    from pathlib import Path
+
+    head = Path(path).read_bytes()[: 1 << 16]
+    fields, start = {}, 0
+    for m in re.finditer(rb"^[ \t]*(\w+)[ \t]*=[ \t]*([^\r\n]*)(\r?\n|$)", head, re.M):
+        fields[m.group(1).decode("latin-1").lower()] = m.group(2).decode("latin-1").strip()
+        if m.group(1).lower() == b"elementdatafile":
+            start = m.end()
+            break
+    name = fields.get("elementdatafile", "")
+    if fields.get("compresseddata", "").lower() != "true" or not fields.get("compresseddatasize", "").isdigit():
+        return None
+    if name.upper() != "LOCAL":
+        if " " in name or "%" in name or name.upper() == "LIST":
+            return None
+        path, start = Path(path).parent / name, 0
+    stream = Path(path).read_bytes()[start:]
+    declared = int(fields["compresseddatasize"])
+    msb = fields.get("binarydatabyteordermsb", fields.get("elementbyteordermsb", "")).lower() == "true"
+    inflate = zlib.MAX_WBITS | 32  # a zlib or gzip header
+    return (declared, len(stream), zlib.decompressobj(inflate).decompress(stream[:declared]),
+            zlib.decompress(stream, inflate), ">" if msb else "<")
+
+
+def _vtk_metaimage_shortfall(path, raw, theirs, findings):
+    """``(samples, how many are VTK's)``: VTK's samples of a compressed MetaImage, those it cannot have read
+    replaced by an independent decode.
+
+    The rule (measured on frogtissue.mhd, whose header declares 260,020 of its 262,087 stream bytes): when
+    the header's ``CompressedDataSize`` is shorter than the zlib stream and those bytes decode to fewer samples
+    than the whole stream holds, ``vtkMetaImageReader`` decodes only them and leaves the rest uninitialised
+    (there: 30,963,285 of 31,960,000 samples decoded, equal to Python's zlib decode; of the other 996,715, 2,670
+    differed from the whole stream's decode in one run (VTK's memory zero), 13,520 and 16,172 in two others).
+    Those samples are compared with the decode of the whole stream, and VTK's shortfall is a WARN about VTK and
+    the header, not a disagreement with the reader. Samples VTK did decode stay VTK's: a reader that differs
+    there still FAILs.
+    """
+    got = _metaimage_stream(path)
+    if got is None:
+        return theirs, theirs.size
+    declared, size, part, whole, order = got
+    item = raw.dtype.itemsize
+    have, n = len(part) // item, len(whole) // item
+    if declared >= size or have >= theirs.size or n != theirs.size:
+        return theirs, theirs.size
+    full = np.frombuffer(whole, dtype=raw.dtype.newbyteorder(order)).astype(np.float64)
+    same = int(np.count_nonzero(full[:have] == theirs[:have]))
+    garbage = int(np.count_nonzero(full[have:] != theirs[have:]))
+    findings.append(Finding("WARN", f"VTK truncates: the header's CompressedDataSize ({declared} bytes) is shorter "
+                                    f"than the zlib stream ({size} bytes); vtkMetaImageReader decodes {have} of "
+                                    f"{n} samples (equal to an independent zlib decode at {same}) and leaves "
+                                    f"{n - have} uninitialised ({garbage} differ from the whole stream's decode); "
+                                    "those are compared with the whole stream's decode"))
+    return np.concatenate([theirs[:have], full[have:]]), have
 
 
 def _compare_in_world(path, ds, theirs, grid, ours):
