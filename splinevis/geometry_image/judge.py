@@ -11,7 +11,7 @@
   triangle twice); among the fans that qualify, the one with the shortest diagonals.
 * **build**: the program's ``model_from`` (:func:`.program.model_from`, what
   :meth:`splinevis.plotting.Plotter.add_geometry_image` does), options ``n`` (samples per side, default "auto": :data:`.build.AUTO_SIZES`) and
-  ``fairness`` (default 0.1). A mesh that is not a closed, connected, oriented genus-0 2-manifold raises
+  ``fairness`` (default "auto": :data:`.build.AUTO_FAIRNESS`). A mesh that is not a closed, connected, oriented genus-0 2-manifold raises
   :class:`splinevis.errors.MeshTopologyError` naming the check that failed; it is not caught (``run.py``
   makes it the FAIL).
 * **add**: ``Plotter.add_geometry_image`` with its defaults (option ``level``, default 3).
@@ -79,7 +79,7 @@ from .build import FOLDED_WARNING
 __all__ = ["JUDGE"]
 
 #: Option defaults: ``n`` and ``fairness`` of the build, ``level`` drawn, ``measure_level`` (None: ``level`` + 1).
-DEFAULTS = {"n": "auto", "fairness": 0.1, "level": 3.0, "measure_level": None}
+DEFAULTS = {"n": "auto", "fairness": "auto", "level": 3.0, "measure_level": None}
 
 #: Verdict thresholds (module docstring): distances in units of the input's bounding-box diagonal.
 THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FOLDED_WARNING, "reversed_fail": 1e-3}
@@ -99,6 +99,10 @@ class MeshData:
 
     mesh: object  # pyvista.PolyData of triangles
     name: str
+
+
+def _fairness(value):
+    return value if isinstance(value, str) else float(value)
 
 
 def _option(options, key):
@@ -127,7 +131,7 @@ def _build(data: MeshData, options, findings):
 
     n = _option(options, "n")
     n = n if n == "auto" else int(n)
-    return get("geometry_image").model_from(data.mesh, n, fairness=float(_option(options, "fairness")),
+    return get("geometry_image").model_from(data.mesh, n, fairness=_fairness(_option(options, "fairness")),
                                             name=data.name)
 
 

@@ -182,7 +182,7 @@ def displacement_map(image: GeometryImage, mesh, level: int, *, backend: str = "
     return np.einsum("ij,ij->i", C - p.reshape(-1, 3), n.reshape(-1, 3)).reshape(p.shape[:2])
 
 
-def model_from(data, n="auto", *, fairness: float = 0.1, **options) -> GeometryImage:
+def model_from(data, n="auto", *, fairness="auto", **options) -> GeometryImage:
     """A :class:`GeometryImage` from ``data``: itself, an ``(n, n, 3)`` control array, or a closed genus-0 mesh
     (pyvista PolyData or a file pyvista reads), built by :func:`.build.geometry_image_from_mesh` (call that for
     the build report: times per stage, stretch, distance to the mesh); ``n="auto"`` picks the image size from the
