@@ -287,3 +287,33 @@ def test_missing_damaged_and_misused_files(tmp_path):
     (tmp_path / "other.gz").write_bytes(gzip.compress(b"x"))
     with pytest.raises(ValueError, match=r"gzip-compressed \(other than \.nii\.gz\) files are not read"):
         read_volume(tmp_path / "other.gz")
+
+
+@pytest.mark.parametrize("form", ["sform", "qform"])
+def test_the_check_judge_places_vtks_reading_by_the_files_transform(tmp_path, form):
+    """``vtkNIFTIImageReader`` returns the lattice at origin 0 and keeps the sform/qform as a separate matrix; the
+    volume judge moves VTK's points by it before matching them with the reader's world positions. The transform
+    has an offset, a rotation about z and (for the qform) qfac = -1, so VTK's bare points are far from every world
+    position: without the move all 60 samples differ. Tolerance: the judge matches positions to 1e-3 of the
+    smallest spacing; float32 storage of the transform moves a point by ~1e-7 of its coordinates, far below."""
+    import pyvista as pv
+
+    from splinevis.io import VolumeGrid
+    from splinevis.volume.judge import _compare_in_world
+
+    c, s = np.cos(0.3), np.sin(0.3)
+    A = np.eye(4)
+    A[:3, :3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.diag([2.0, 3.0, -4.0 if form == "qform" else 4.0])
+    A[:3, 3] = [10.0, -20.0, 5.0]
+    kw = {"sform": A, "sform_code": 2} if form == "sform" else {"qform": A, "qform_code": 1}
+    p = write(tmp_path / f"{form}.nii", ramp(), **kw)
+    with warnings.catch_warnings():  # the float32 sform is orthonormal to its precision only: the reader says so
+        warnings.simplefilter("ignore", UserWarning)
+        grid = read_volume(p)
+    ds = pv.read(p)
+    theirs = np.asarray(ds.point_data[ds.active_scalars_name], dtype=np.float64)
+    assert _compare_in_world(p, ds, theirs, grid, np.asarray(grid.values, dtype=np.float64)) == (0, "")
+    moved = VolumeGrid(grid.values, spacing=grid.spacing, origin=np.asarray(grid.origin) + [0.5, 0, 0],
+                       direction=grid.direction)
+    bad, why = _compare_in_world(p, ds, theirs, moved, np.asarray(grid.values, dtype=np.float64))
+    assert bad == 60 and "sample positions differ" in why

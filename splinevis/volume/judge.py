@@ -12,7 +12,9 @@
   volume, else a fixed pseudo-random choice), max and RMS relative to the value range. The quadratic scheme is a
   quasi-interpolant (it reproduces linear functions, not the samples): reported, not judged. *Reader against
   VTK*: where VTK reads the file too, every sample must sit at the same world position (VTK's points, with the
-  image's direction matrix) with the same value; a flipped axis, a wrong origin or a byte-swapped value is a FAIL.
+  image's direction matrix; for a NIfTI file moved by the sform, else the qform, which ``vtkNIFTIImageReader``
+  keeps apart from its points) with the same value; a flipped axis, a wrong origin or a byte-swapped value is a
+  FAIL.
   Where VTK is known to read short (a compressed MetaImage whose header's ``CompressedDataSize`` is shorter than its
   zlib stream: ``vtkMetaImageReader`` decodes the declared bytes only and leaves the other samples uninitialised),
   those samples are compared with an independent zlib decode of the whole stream, and VTK's shortfall is a WARN
@@ -209,9 +211,9 @@ def _vtk_metaimage_shortfall(path, raw, theirs, findings):
 
 
 def _compare_in_world(path, ds, theirs, grid, ours):
-    """Samples of two readings matched by world position (VTK's points include the image's direction matrix):
-    (number that differ, the first difference in words)."""
-    pts = np.asarray(ds.points, dtype=np.float64)
+    """Samples of two readings matched by world position (VTK's points include the image's direction matrix, and a
+    NIfTI file's sform or qform, :func:`_vtk_placement`): (number that differ, the first difference in words)."""
+    pts = _vtk_placement(path, np.asarray(ds.points, dtype=np.float64))
     k, j, i = np.indices(grid.shape).reshape(3, -1)
     mine = grid.lattice_to_world(grid.to_world(np.column_stack([i, j, k]).astype(float)))
     unit = 1e-3 * float(np.min(grid.spacing))
@@ -232,6 +234,25 @@ def _compare_in_world(path, ds, theirs, grid, ours):
     return 0, ""
 
 
+def _vtk_placement(path, pts):
+    """VTK's points of a NIfTI file moved into its world frame: ``vtkNIFTIImageReader`` returns the lattice at origin 0
+    and gives the sform (``sform_code > 0``), else the qform, as a separate matrix from image to world points."""
+    if not str(path).lower().endswith((".nii", ".nii.gz")):
+        return pts
+    from vtkmodules.vtkIOImage import vtkNIFTIImageReader
+
+    reader = vtkNIFTIImageReader()
+    reader.SetFileName(str(path))
+    reader.UpdateInformation()
+    header = reader.GetNIFTIHeader()
+    m = reader.GetSFormMatrix() if header.GetSFormCode() > 0 else \
+        reader.GetQFormMatrix() if header.GetQFormCode() > 0 else None
+    if m is None:
+        return pts
+    a = np.array([[m.GetElement(r, c) for c in range(4)] for r in range(4)])
+    return pts @ a[:3, :3].T + a[:3, 3]
+
+
 def _add(plotter, model, options):
     from ..programs import get
 
@@ -243,4 +264,4 @@ def _add(plotter, model, options):
 
 
 JUDGE = FamilyJudge("volume", "flying edges", _read, _build, _baseline, _accuracy, _add,
-                    description="volumes (VTK, MetaImage, NRRD, Gaussian cube, raw)")
+                    description="volumes (VTK, MetaImage, NRRD, NIfTI, Gaussian cube, raw)")
