@@ -2,6 +2,7 @@
 
 import doctest
 import gzip
+import warnings
 
 import numpy as np
 import pytest
@@ -675,6 +676,7 @@ def test_non_uniform_cell_data_file_message_gives_a_command_that_makes_a_uniform
         read_volume("cth_small.vtr")
     msg = str(info.value)
     assert "x coordinates are not uniformly spaced" in msg and "z coordinates are not uniformly spaced" in msg
+    assert "The spline schemes need a uniform grid: pass resample=True, or resample onto an ImageData" in msg
     assert "cell data only (2 arrays: 'Pressure', 'X Velocity'; no point data)" in msg
     command = re.search(r"In Python: (.*)\. Then read_volume\('cth_small_uniform\.vti', scalars='Pressure'\)", msg)
     exec(command.group(1), {})  # pasted as the message gives it
@@ -695,6 +697,13 @@ def test_non_uniform_cell_data_file_message_gives_a_command_that_makes_a_uniform
     assert s.spacing == g.spacing and np.array_equal(s.values, g.values)
     with pytest.raises(ValueError, match=r"uniform grid: pass resample=True, or resample onto an ImageData"):
         from_pyvista(rg, "cth_small.vtr", "Pressure", None, resample=False)
+    # read_volume(..., resample=True) does the same from the file: the same lattice and values as the command's
+    with pytest.warns(UserWarning, match=r"cth_small\.vtr: x coordinates are not uniformly spaced.*resampled "
+                                         r"trilinearly onto a uniform ImageData"):
+        r = read_volume("cth_small.vtr", scalars="Pressure", resample=True)
+    assert r.spacing == g.spacing and r.origin == g.origin and np.array_equal(r.values, g.values)
+    with pytest.raises(TypeError, match="resample must be True or False"):
+        read_volume("cth_small.vtr", scalars="Pressure", resample="yes")
 
 
 def test_non_uniform_grid_object_message_command_reproduces_a_linear_field():
@@ -717,3 +726,14 @@ def test_non_uniform_grid_object_message_command_reproduces_a_linear_field():
     # trilinear interpolation reproduces a linear field exactly; float64 rounding of a few operations on
     # values of size ~5 stays far below 1e-12
     assert np.abs(volume.values - expected).max() < 1e-12
+    # read_volume(grid object, resample=True): the same resampling, the same bound on a linear field
+    with pytest.warns(UserWarning, match="resampled trilinearly"):
+        direct = read_volume(rg, resample=True)
+    assert direct.spacing == volume.spacing and np.abs(direct.values - expected).max() < 1e-12
+    # a uniform lattice is read as it is, with or without resample=True (no warning: warnings are errors here)
+    uniform = pv.RectilinearGrid(np.array([0.0, 0.5, 1.0]), y[:2], z)
+    uniform.point_data["f"] = np.arange(uniform.n_points, dtype=float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        kept = read_volume(uniform, resample=True)
+    assert kept.spacing == (0.5, 0.5, 0.5) and np.array_equal(kept.values.ravel(), uniform.point_data["f"])

@@ -14,7 +14,7 @@
   ========================  ===============================================================
   ``.vti``                  VTK XML ImageData (pyvista), direction matrix honoured
   ``.vtk``                  legacy VTK STRUCTURED_POINTS (or uniform rectilinear/structured)
-  ``.vtr`` ``.vts``         VTK XML RectilinearGrid / StructuredGrid with uniform spacing
+  ``.vtr`` ``.vts``         VTK XML RectilinearGrid / StructuredGrid, uniform (else ``resample=True``)
   ``.mha`` ``.mhd``         MetaImage (``vtkMetaImageReader``), TransformMatrix honoured
   ``.nrrd`` ``.nhdr``       NRRD, parsed here (raw, gzip, bzip2, ascii, hex encodings)
   ``.slc``                  SLC (``vtkSLCReader``; 8-bit, no origin in the format)
@@ -40,10 +40,10 @@ Conventions kept by every reader
 * **Direction matrices.** A grid whose direction matrix is diagonal with entries +-1 (axis flips) is
   normalised: every flipped axis is reversed in the array and the origin moves to the sample with the
   smallest coordinate, so the returned grid shows the same picture with positive spacing. Negative
-  spacings (VTK, NRRD ``spacings``) are treated the same way. Any other direction (a rotation, or a
-  permutation of the axes) raises ValueError: the spline schemes need axis-aligned grids, and dropping
-  the direction would draw a wrong picture. Off-diagonal entries below ``1e-9`` times the axis length
-  count as rounding and are ignored.
+  spacings (VTK, NRRD ``spacings``) are treated the same way. Any other orthonormal direction (a rotation, a
+  permutation of the axes) is kept in ``VolumeGrid.direction`` (rotated orthogonal lattices, below); a shear
+  raises ValueError, dropping it would draw a wrong picture. Orthonormality is judged at the precision the
+  source carries (:func:`.volume_samples.orthonormal_direction`).
 * **Cell data.** VTK cell data of an ``ImageData`` hold one value per voxel; they are read as samples
   at the voxel centres: a grid of ``(nz-1, ny-1, nx-1)`` samples whose origin is half a voxel inside.
   Point data are preferred when both exist; ``scalars=`` picks an array by name from either.
@@ -55,6 +55,9 @@ Conventions kept by every reader
   in world distance (anisotropic spacing counts, ``scipy.ndimage.distance_transform_edt``); a number
   ``fill=0.0`` puts that value into every gap.
 * At least 2 samples per axis (the spline schemes themselves need 3 and check that).
+* **Non-uniform lattices** (a ``RectilinearGrid`` or axis-aligned ``StructuredGrid`` whose steps vary) are
+  refused with the Python lines that resample them; ``resample=True`` resamples instead, with a warning
+  (:func:`.volume_vtk.resample_to_image`).
 * **Slice stacks.** A folder of headerless slice files (or a glob such as ``"ct/s_*.raw"``) with
   ``shape=(ny, nx)``, ``dtype=``, ``byteorder=`` reads as one volume, the files sorted naturally by name
   (:mod:`.slices`).
@@ -272,7 +275,7 @@ class VolumeGrid:
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, dtype=None, byteorder=None,
-                header_bytes=0, fill=None, component=None) -> VolumeGrid:
+                header_bytes=0, fill=None, component=None, resample=False) -> VolumeGrid:
     """Read volume data into a :class:`VolumeGrid` (see the module notes for formats and conventions).
 
     Parameters
@@ -301,6 +304,12 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
     component : None, int or "magnitude"
         For arrays with several components: pick one (0-based) or take the Euclidean norm. For a 4-D NIfTI
         file (a series of volumes): the index of the volume to read (required there).
+    resample : bool
+        For a ``RectilinearGrid`` or axis-aligned ``StructuredGrid`` (object or ``.vtr``/``.vts``/``.vtk`` file)
+        whose steps are not uniform: False (default) raises ValueError with the lines that resample it; True
+        resamples it onto a uniform ``ImageData`` (cell data made point data, the finest step of each axis, the
+        same bounds, trilinear; :func:`.volume_vtk.resample_to_image`) with a warning saying so. Uniform
+        lattices and the other sources are not affected.
 
     Returns
     -------
@@ -313,7 +322,7 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
     TypeError
         Unsupported source type or non-numeric samples.
     ValueError
-        Not 3-D, fewer than 2 samples on an axis, rotated or permuted grid, non-uniform spacing,
+        Not 3-D, fewer than 2 samples on an axis, shear, non-uniform spacing without ``resample=True``,
         ambiguous or missing array, multi-component array without ``component=``, missing samples
         without ``fill=``, raw file of the wrong size, unreadable file.
 
@@ -338,6 +347,8 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
     if component is not None and not (component == "magnitude" if isinstance(component, str) else
                                       isinstance(component, (int, np.integer)) and not isinstance(component, bool)):
         raise ValueError(f"component {component!r} is not known; pass an int (0-based component) or 'magnitude'.")
+    if not isinstance(resample, (bool, np.bool_)):
+        raise TypeError(f"resample must be True or False, got {resample!r}.")
     if scalars is not None and not isinstance(scalars, str):
         raise TypeError(f"scalars must be the name (str) of a data array, got {type(scalars).__name__}.")
     if spacing is not None:
@@ -357,7 +368,7 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
                              f"{_describe(source)} carries that information itself. Drop the argument.")
 
     samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, shape=shape, dtype=dtype,
-                    byteorder=byteorder, header_bytes=header_bytes, component=component)
+                    byteorder=byteorder, header_bytes=header_bytes, component=component, resample=bool(resample))
     return _finish(samples, fill)
 
 
@@ -369,7 +380,8 @@ def _describe(source) -> str:
     return f"a {type(source).__name__}"
 
 
-def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes, component) -> VolumeSamples:
+def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes, component,
+              resample) -> VolumeSamples:
     kind = source_kind(source)
     if kind == "path" and (is_glob(source) or Path(source).is_dir()):
         if scalars is not None:
@@ -377,14 +389,14 @@ def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, head
         return read_slices(source, shape, dtype, byteorder, header_bytes, spacing, origin, component)
     if kind == "path":
         return _read_file(Path(source), scalars=scalars, spacing=spacing, origin=origin, shape=shape, dtype=dtype,
-                          byteorder=byteorder, header_bytes=header_bytes, component=component)
+                          byteorder=byteorder, header_bytes=header_bytes, component=component, resample=resample)
     if kind == "vtk":
         import pyvista as pv
 
         grid = pv.wrap(source)
         name = f"pyvista.{type(grid).__name__}"
         refuse_own_geometry(spacing, origin, name, applies_to=GEOMETRY_ARGS_APPLY_TO)
-        return from_pyvista(grid, name, scalars, component)
+        return from_pyvista(grid, name, scalars, component, resample=resample)
     if kind == "array":
         if scalars is not None:
             raise ValueError("scalars= names a data array of a pyvista grid or a file; a numpy array has none.")
@@ -395,7 +407,7 @@ def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, head
 
 
 def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes,
-               component) -> VolumeSamples:
+               component, resample) -> VolumeSamples:
     ext = _extension(path)
     if ext in _UNSUPPORTED:
         raise ValueError(f"{path}: {_UNSUPPORTED[ext]} files are not read (VTK's readers ignore parts of their "
@@ -429,7 +441,8 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
             samples.origin = origin
         return samples
     refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
-    samples = from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component)
+    samples = from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component,
+                           resample=resample)
     if ext in (".mha", ".mhd") and samples.direction != VolumeSamples.direction:
         samples.direction = orthonormal_direction(metaimage_direction(path, str(path)), str(path))
     return samples
