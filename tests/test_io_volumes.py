@@ -563,6 +563,47 @@ def test_nrrd_space_directions_judged_at_the_printed_precision(tmp_path):
     assert np.abs(D - R).max() <= 2 * np.sqrt(3) * (2 * np.sqrt(3) * 5e-5 / 0.9)
 
 
+def _metaimage_with_matrix(path, columns, fmt):
+    """A MetaImage of 2 x 3 x 4 int16 samples whose TransformMatrix lists ``columns`` (ITK: axis after axis)."""
+    matrix = " ".join(fmt % float(v) for v in np.asarray(columns, dtype=np.float64).T.ravel())
+    hdr = (f"ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+           f"CompressedData = False\nTransformMatrix = {matrix}\nOffset = 1 2 3\nElementSpacing = 0.5 0.5 2\n"
+           f"DimSize = 4 3 2\nElementType = MET_SHORT\nElementDataFile = LOCAL\n")
+    path.write_bytes(hdr.encode() + np.arange(24, dtype="<i2").tobytes())
+    return path
+
+
+def test_metaimage_transform_matrix_judged_at_the_printed_precision(tmp_path):
+    # a rotation printed with 4 decimals (as scanners' exports do): orthogonal to ~1e-4 only, refused before
+    # (fixed tolerance 1e-6); read in its frame with the correction reported
+    R = _rotation(0.2, -0.4, 0.7)
+    printed = np.round(R, 4)
+    assert np.abs(printed.T @ printed - np.eye(3)).max() > 1e-6
+    p = _metaimage_with_matrix(tmp_path / "rot.mha", R, "%.4f")
+    with pytest.warns(UserWarning, match=r"rot\.mha: the lattice axes are orthonormal only to the precision the "
+                                         r"source carries .* drawn with the nearest orthonormal matrix"):
+        r = read_volume(p)
+    D = np.asarray(r.direction)
+    assert np.abs(D.T @ D - np.eye(3)).max() < 1e-15 and r.is_rotated
+    # each printed unit column within 2 sqrt(3) 5e-5 of R's (volume_samples.unit_rounding, |v| = 1); the polar
+    # factor within twice the Frobenius norm of that error (as for NRRD above)
+    assert np.abs(D - R).max() <= 2 * np.sqrt(3) * (2 * np.sqrt(3) * 5e-5)
+    assert r.spacing == (0.5, 0.5, 2.0) and r.origin == (1.0, 2.0, 3.0)
+    assert np.array_equal(r.values.ravel(), np.arange(24))
+    # a real shear (a 1e-2 tilt between x and y, 200 times the printed precision) is still refused, naming it
+    shear = R @ np.array([[1.0, 1e-2, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    shear /= np.linalg.norm(shear, axis=0)
+    with pytest.raises(ValueError, match=r"shear\.mha: the direction matrix .* is not orthonormal \(a shear or "
+                                         r"non-orthogonal axes, deviation .* beyond the tolerance .* derived from "
+                                         r"the precision the source prints"):
+        read_volume(_metaimage_with_matrix(tmp_path / "shear.mha", shear, "%.4f"))
+    # printed in full (repr): no correction beyond float64 rounding, so no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        full = read_volume(_metaimage_with_matrix(tmp_path / "full.mha", R, "%r"))
+    assert np.abs(np.asarray(full.direction) - R).max() < 1e-15
+
+
 # ---- stacks of raw slices -------------------------------------------------------------------------------
 def test_folder_and_glob_of_raw_slices_read_as_one_volume_in_natural_order(tmp_path):
     from datasets_synthetic.volume_files import write_slices

@@ -19,6 +19,9 @@ raises), uniform ``RectilinearGrid`` and axis-aligned uniform ``StructuredGrid``
   the declared bytes only and ``vtkMetaImageReader`` leaves the other samples uninitialised, silently; the whole
   stream is decoded instead, with a warning giving both sizes (measured on frogtissue.mhd: 260,020 declared
   bytes of 262,087 hold 30,963,285 of its 31,960,000 samples).
+* A MetaImage's ``TransformMatrix`` is taken from the header (:func:`metaimage_direction`: ``vtkMetaImageReader``
+  transposes a rotation) and judged orthonormal at the precision the header prints it, as the NRRD and cube
+  readers judge theirs: a rotation printed with 4 decimals reads, with a warning reporting the correction.
 * Legacy ``.vtk`` files written by VTK carry spacing and origin with 6 significant digits only (an
   origin of ``1e6 + 0.1`` is written as ``1e+06``); the reader keeps what the file says.
   ``datasets_synthetic.volumes.write_volume`` writes full precision.
@@ -36,7 +39,7 @@ import numpy as np
 from .._warnings import warn_user
 from ._common import nonuniform_message, step_deviation
 from .volume_samples import (VolumeSamples, axis_signs, check_samples, check_size, orthonormal_direction,
-                             pick_component)
+                             pick_component, printed_rounding, unit_rounding)
 
 __all__ = ["from_pyvista", "read_vtk_file", "resample_to_image", "resample_advice"]
 
@@ -131,7 +134,8 @@ def _choose_array(grid, where, scalars):
     return assoc, name, np.asarray(data[name])
 
 
-def from_pyvista(grid, where: str, scalars, component, resample=None) -> VolumeSamples:
+def from_pyvista(grid, where: str, scalars, component, resample=None, direction=None,
+                 rounding=None) -> VolumeSamples:
     """Take the samples of a pyvista ``ImageData``, uniform ``RectilinearGrid`` or ``StructuredGrid``.
 
     Parameters
@@ -148,6 +152,12 @@ def from_pyvista(grid, where: str, scalars, component, resample=None) -> VolumeS
         A ``RectilinearGrid``/``StructuredGrid`` lattice with non-uniform steps: True resamples it
         (:func:`resample_to_image`, with a warning saying how); False or None raise ValueError with the
         command that resamples (False: the caller offers ``resample=True``, and the message says so).
+    direction : (3, 3) array_like, optional
+        An ``ImageData``'s direction matrix as its file gives it, used instead of the grid's (a MetaImage's
+        ``TransformMatrix``, :func:`metaimage_direction`: ``vtkMetaImageReader`` transposes a rotation).
+    rounding : float or (3,) floats, optional
+        Bound on the error of each unit column of ``direction`` as read (the precision the file prints),
+        for :func:`.volume_samples.orthonormal_direction`; None: a matrix of unknown provenance.
 
     Returns
     -------
@@ -173,12 +183,14 @@ def from_pyvista(grid, where: str, scalars, component, resample=None) -> VolumeS
         spacing = np.array(grid.spacing, dtype=np.float64)
         origin = np.array(grid.origin, dtype=np.float64)
         extent = np.array(grid.extent, dtype=np.int64)[0::2]
-        direction = np.asarray(grid.direction_matrix, dtype=np.float64)
+        direction = np.asarray(grid.direction_matrix if direction is None else direction, dtype=np.float64)
         try:
             sign = axis_signs(direction, where)
             rotation = None
         except ValueError:  # a rotated orthogonal lattice is kept with its direction; a shear raises here
-            rotation = np.asarray(orthonormal_direction(direction * np.sign(spacing)[None, :], where))
+            rotation = np.asarray(orthonormal_direction(direction * np.sign(spacing)[None, :], where,
+                                                        rounding=rounding))
+            direction = rotation * np.sign(spacing)[None, :]  # the positions below at the corrected matrix
             sign = np.ones(3)
         first = origin + direction @ (extent * spacing)  # world position of the first stored point
         assoc, name, arr = _choose_array(grid, where, scalars)
@@ -378,21 +390,31 @@ def resample_advice(grid, coords, where: str, scalars) -> str:
 
 
 def metaimage_direction(path: Path, where: str):
-    """The direction matrix of a MetaImage header (``TransformMatrix``/``Orientation``/``Rotation``), or None.
+    """``(direction, rounding)`` of a MetaImage header (``TransformMatrix``/``Orientation``/``Rotation``), or None.
 
     MetaIO lists the direction vector of each index axis in turn (ITK's convention: the columns of the
     direction matrix); ``vtkMetaImageReader`` takes the list row by row, i.e. it transposes a rotation.
-    Axis flips (diagonal) are the same either way.
+    Axis flips (diagonal) are the same either way. ``rounding`` bounds the error of each unit column as
+    the header prints it (:func:`.volume_samples.printed_rounding`, :func:`.volume_samples.unit_rounding`):
+    a matrix written with 4 decimals is judged orthonormal at that precision, as the NRRD and cube readers do.
     """
     with open(path, "rb") as fh:
         head = fh.read(1 << 16).decode("latin-1")
     for line in head.splitlines():
         key, sep, val = line.partition("=")
         if sep and key.strip().lower() in ("transformmatrix", "orientation", "rotation"):
-            vals = [float(v) for v in val.split()]
+            texts = val.split()
+            try:
+                vals = [float(v) for v in texts]
+            except ValueError:
+                raise ValueError(f"{where}: {key.strip()} = {val.strip()!r} is not 9 numbers.") from None
             if len(vals) != 9:
                 raise ValueError(f"{where}: {key.strip()} has {len(vals)} numbers; a 3-D image needs 9.")
-            return np.array(vals, dtype=np.float64).reshape(3, 3).T
+            m = np.array(vals, dtype=np.float64).reshape(3, 3).T
+            if not np.isfinite(m).all() or np.any(np.linalg.norm(m, axis=0) == 0):
+                raise ValueError(f"{where}: {key.strip()} = {val.strip()!r} has a non-finite entry or a zero "
+                                 "axis; each axis needs a direction.")
+            return m, unit_rounding(m, printed_rounding(texts).reshape(3, 3).max(axis=1))
         if key.strip().lower() == "elementdatafile":
             break
     return None

@@ -441,11 +441,10 @@ def _read_file(path: Path, *, scalars, spacing, origin, shape, dtype, byteorder,
             samples.origin = origin
         return samples
     refuse_own_geometry(spacing, origin, str(path), applies_to=GEOMETRY_ARGS_APPLY_TO)
-    samples = from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component,
-                           resample=resample)
-    if ext in (".mha", ".mhd") and samples.direction != VolumeSamples.direction:
-        samples.direction = orthonormal_direction(metaimage_direction(path, str(path)), str(path))
-    return samples
+    header = metaimage_direction(path, str(path)) if ext in (".mha", ".mhd") else None
+    direction, rounding = header if header is not None else (None, None)
+    return from_pyvista(read_vtk_file(path, VOLUME_EXTENSIONS[ext]), str(path), scalars, component,
+                        resample=resample, direction=direction, rounding=rounding)
 
 
 # --------------------------------------------------------------------------------------------------
