@@ -158,3 +158,90 @@ def test_a_file_crs_proj_cannot_express_is_our_error(tmp_path, monkeypatch):
                                          r"set one PROJ knows, e\.g\. gdal_edit\.py -a_srs EPSG:32633 odd\.tif") as info:
         splinevis.io.read_heights(path)
     assert type(info.value) is ValueError
+
+
+def test_a_raster_on_the_polar_cap_away_from_the_pole_goes_to_ups(tmp_path):
+    # latitudes 84.5..85.5, longitudes 40..50: beyond UTM's 84 N. The former code cropped the UPS grid to the
+    # inside of the footprint, fewer than 2 x 2 samples, and refused it with "is the CRS 'EPSG:4326' right?"
+    # (measured on that code); now the half of the nodes outside the wedge-shaped footprint is said (with the
+    # read options that fill them), and with fill= all of the area is kept.
+    lon, lat = np.meshgrid(40.05 + 0.1 * np.arange(100), 84.51 + 0.02 * np.arange(50))
+    path = _tif(tmp_path, "cap.tif", 100.0 * (lat - 84.0), (0.1, 0.02), (40.05, 84.51), 4326)
+    with pytest.raises(ValueError, match=r"cap\.tif: the grid reaches the polar cap .* of the nodes of the "
+                                         r"EPSG:32661 grid .* Pass fill='nearest'") as info:
+        splinevis.io.read_heights(path)
+    assert "right?" not in str(info.value)
+    grid = splinevis.io.read_heights(path, fill="nearest")
+    assert "to EPSG:32661" in grid.source and "100.00 % of the footprint kept" in grid.source
+
+
+# ---------------------------------------------------------------------------------------------------
+# USGS DEM files the former parser refused or GDAL misplaced
+# ---------------------------------------------------------------------------------------------------
+def test_a_usgs_dem_ending_with_a_type_c_record_reads(tmp_path):
+    # The former parser took the type C (accuracy) record after the last profile for one more type B record and
+    # refused the file as "truncated or malformed type B record ... download it again". Now: every sample read.
+    from datasets_synthetic.dem_files import write_usgs_ascii_dem
+
+    h = 300.0 + np.add.outer(np.arange(7.0), 2.0 * np.arange(5.0))
+    path = write_usgs_ascii_dem(tmp_path / "acc.dem", h, 30.0, (5e5, 5.1e6), z_resolution=0.01,
+                                accuracy=(1, 2, 3, 4, 28, 1, 0, 0, 7, 30))
+    g = splinevis.io.read_heights(path)
+    np.testing.assert_array_equal(g.heights, h)  # whole metres: exact in units of 0.01 m
+    assert g.origin == (5e5, 5.1e6) and g.crs == "EPSG:32633"
+
+
+def test_a_usgs_dem_named_tif_is_read_by_content_at_its_true_origin(tmp_path):
+    # The former code sent a .tif to GDAL, whose USGSDEM driver snaps the origin to a multiple of the spacing
+    # (10 m off here: 500010 -> 500000) and invents a row (on that code: "8 of 56 samples are missing", the fill
+    # advice misleading); content sniffing sends it to our parser.
+    from datasets_synthetic.dem_files import write_usgs_ascii_dem
+
+    h = 200.0 + np.add.outer(np.arange(6.0), np.arange(8.0))
+    dem = write_usgs_ascii_dem(tmp_path / "a.dem", h, 30.0, (500010.0, 5100020.0), z_resolution=0.01)
+    tif = tmp_path / "really_a_dem.tif"
+    tif.write_bytes(dem.read_bytes())
+    g = splinevis.io.read_heights(tif)
+    assert g.shape == (6, 8) and g.origin == (500010.0, 5100020.0)
+    np.testing.assert_array_equal(g.heights, h)
+
+
+# ---------------------------------------------------------------------------------------------------
+# Volumes: lattice axes at the file's precision, isovalues the spline does not reach
+# ---------------------------------------------------------------------------------------------------
+def test_cube_axes_orthogonal_to_the_printed_decimals_read(tmp_path):
+    # 0.1 Bohr steps on a rotated lattice printed with 6 decimals (%12.6f): the unit axes are orthogonal to
+    # ~1e-5 only. The former fixed tolerance (1e-6) refused the file as "shear or non-orthogonal"; judged at the
+    # printed precision it reads in its frame, the correction reported in a warning.
+    c, s = np.cos(0.7), np.sin(0.7)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s],
+                                                                           [0.0, s, c]])
+    printed = np.round(0.1 * R, 6)
+    unit = printed / np.linalg.norm(printed, axis=0)
+    assert np.abs(unit.T @ unit - np.eye(3)).max() > 1e-6  # what the former tolerance refused
+    axes = "\n".join(f"3 {printed[0, k]:12.6f}{printed[1, k]:12.6f}{printed[2, k]:12.6f}" for k in range(3))
+    data = " ".join(str(float(v)) for v in range(27))
+    (tmp_path / "rot.cube").write_text(f"c\nc\n1 0.0 0.0 0.0\n{axes}\n8 0.0 0.0 0.0 0.0\n{data}\n")
+    with pytest.warns(UserWarning, match=r"rot\.cube: the lattice axes are orthonormal only to the precision"):
+        g = splinevis.io.read_volume(tmp_path / "rot.cube")
+    assert g.is_rotated and g.shape == (3, 3, 3)
+
+
+def _gaussian_ball():
+    z, y, x = np.mgrid[-6:7, -6:7, -6:7].astype(float)
+    return np.exp(-(x ** 2 + y ** 2 + z ** 2) / (2 * 1.2 ** 2))  # one sample of 1 at the centre
+
+
+@pytest.mark.parametrize("sign, fraction", [(1, 1.0), (1, 0.95), (-1, 1.0)])
+def test_an_isovalue_the_spline_does_not_reach_is_said(sign, fraction):
+    # The data's maximum (sign 1, fraction 1), 0.95 of it (inside the data's range) and the minimum of the
+    # negated field: the quadratic quasi-interpolant smooths the one-sample peak to 0.78, so each isovalue lies
+    # outside the spline's range and the picture is blank. The former code drew it without a word; now a
+    # warning gives the spline's range and the option that reaches the samples.
+    d = sign * _gaussian_ball()
+    iso = fraction * (d.max() if sign > 0 else d.min())
+    pl = splinevis.Plotter(off_screen=True, window_size=(40, 30))
+    with pytest.warns(UserWarning, match=r"outside what the spline reaches: the spline's values lie within .* "
+                                         r"prefilter='interpolate' makes the spline pass through the samples"):
+        pl.add_isosurface(d, iso)
+    pl.close()
