@@ -19,6 +19,8 @@ environment     reflection of a latitude-longitude environment image
 reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray (zebra)
 highlight_lines   bands where the surface normal line meets one of a family of linear lights (view-independent)
 isophotes       stripes of constant ``dot(n, L)``
+antialias       the stripes above averaged over each pixel's footprint (on by default whenever a stripe
+                effect is declared; ``antialias=False`` gives the plain step)
 transparency    ``opacity < 1``: alpha output, composited by VTK's translucent pass
 normals         output colour = encoded unit normal ``0.5 * (n + 1)`` (replaces shading)
 curvature       output colour = a curvature (mean, Gaussian, principal) through a diverging colormap
@@ -38,7 +40,7 @@ import numpy as np
 
 from ._validation import as_float64_array, check_choice
 
-__all__ = ["Style", "EFFECTS", "OUTPUT_MODES", "MAX_LIGHTS", "CURVATURE_KINDS", "line_frame"]
+__all__ = ["Style", "EFFECTS", "OUTPUT_MODES", "MAX_LIGHTS", "CURVATURE_KINDS", "STRIPE_EFFECTS", "line_frame"]
 
 MAX_LIGHTS = 4
 OUTPUT_MODES = ("normals", "curvature", "draft", "depth")
@@ -54,12 +56,17 @@ EFFECTS: dict[str, tuple[str, str]] = {
     "reflection_lines": ("SV_REFLECTION_LINES", "lib/effects/reflection_lines.glsl"),
     "highlight_lines": ("SV_HIGHLIGHT_LINES", "lib/effects/highlight_lines.glsl"),
     "isophotes": ("SV_ISOPHOTES", "lib/effects/isophotes.glsl"),
+    "antialias": ("SV_ANTIALIAS", "lib/effects/stripes.glsl"),
     "transparency": ("SV_TRANSPARENCY", "lib/effects/transparency.glsl"),
     "normals": ("SV_OUT_NORMALS", "lib/effects/normals.glsl"),
     "curvature": ("SV_OUT_CURVATURE", "lib/effects/curvature.glsl"),
     "draft": ("SV_OUT_DRAFT", "lib/effects/draft.glsl"),
     "depth": ("SV_OUT_DEPTH", "lib/effects/depth.glsl"),
 }
+
+#: The effects drawn as light/dark stripes of a smooth quantity (``glsl/lib/effects/stripes.glsl``), which
+#: ``Style.antialias`` filters over the pixel.
+STRIPE_EFFECTS = ("reflection_lines", "highlight_lines", "isophotes")
 
 # Default light rig: a headlight slightly above-left and a weaker fill, given in camera coordinates
 # (x right, y up, z towards the viewer) as directions *towards* the light.
@@ -143,6 +150,11 @@ class Style:
         The plane's offset along ``highlight_plane`` (world); default: above the model by its size.
     isophotes : int, optional
         Number of isophote bands of ``dot(n, L)`` for the first light direction.
+    antialias : bool, default True
+        Average the stripes of reflection lines, highlight lines and isophotes over each pixel's footprint
+        (from the screen-space derivatives of the stripe coordinate; ``glsl/lib/effects/stripes.glsl``): a
+        stripe narrower than a pixel fades to its mean instead of aliasing into a moire. False draws the
+        plain step, one sample per pixel. Compiled in only with a stripe effect.
     output : {"normals", "curvature", "draft", "depth"}, optional
         Replace shading by an analysis output.
     curvature : {"mean", "gaussian", "k1", "k2", "max"}, default "mean"
@@ -166,7 +178,7 @@ class Style:
     >>> from splinevis import Style
     >>> s = Style(lights=2, specular=True, reflection_lines=12)
     >>> sorted(s.effect_set())
-    ['lights', 'reflection_lines', 'specular']
+    ['antialias', 'lights', 'reflection_lines', 'specular']
     >>> Style(lights=2).effect_set() == Style(lights=2, color="red").effect_set()
     True
     """
@@ -186,6 +198,7 @@ class Style:
     highlight_plane: tuple = (0.0, 0.0, 1.0)
     highlight_height: float | None = None
     isophotes: int | None = None
+    antialias: bool = True
     output: str | None = None
     curvature: str = "mean"
     pull_direction: tuple = (0.0, 0.0, 1.0)
@@ -229,6 +242,8 @@ class Style:
             v = getattr(self, name)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1):
                 raise ValueError(f"Style.{name} must be a positive integer count of stripes, got {v!r}.")
+        if not isinstance(self.antialias, (bool, np.bool_)):
+            raise ValueError(f"Style.antialias must be True or False, got {self.antialias!r}.")
         if self.isophotes is not None and self.lights == 0:
             raise ValueError("Style.isophotes are bands of dot(n, L) for the first light: set lights >= 1.")
         if self.output is not None:
@@ -257,6 +272,8 @@ class Style:
         --------
         >>> sorted(Style(lights=2, opacity=0.5).effect_set())
         ['lights', 'transparency']
+        >>> sorted(Style(reflection_lines=8).effect_set()), sorted(Style(reflection_lines=8, antialias=False).effect_set())
+        (['antialias', 'lights', 'reflection_lines'], ['lights', 'reflection_lines'])
         >>> Style(lights=2, reflection_lines=12, output="normals").effect_set()
         frozenset({'normals'})
         """
@@ -274,8 +291,8 @@ class Style:
                 on.add(name)
         if self.opacity < 1:
             on.add("transparency")
-        if self.output is not None:
-            on.add(self.output)
+        if self.antialias and on.intersection(STRIPE_EFFECTS):
+            on.add("antialias")
         return frozenset(on)
 
     def defines(self) -> dict:
@@ -298,7 +315,7 @@ class Style:
         Examples
         --------
         >>> Style(lights=2, specular=True, reflection_lines=12).include_files()
-        ['lib/effects/lights.glsl', 'lib/effects/reflection_lines.glsl']
+        ['lib/effects/lights.glsl', 'lib/effects/reflection_lines.glsl', 'lib/effects/stripes.glsl']
         """
         files = []
         for name in EFFECTS:

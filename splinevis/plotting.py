@@ -53,6 +53,26 @@ def _style_from(style, style_kwargs) -> Style:
     return style.replace(**style_kwargs) if style_kwargs else style
 
 
+def _anti_aliasing_choice(value) -> tuple:
+    """``(kind for PyVista's enable_anti_aliasing or None, supersampling factor)`` of ``Plotter(anti_aliasing=)``.
+
+    >>> _anti_aliasing_choice(False), _anti_aliasing_choice(4), _anti_aliasing_choice("ssaa")
+    ((None, 1), (None, 4), ('ssaa', 1))
+    >>> _anti_aliasing_choice(True)
+    Traceback (most recent call last):
+    ValueError: anti_aliasing=True is ambiguous: give False, a supersampling factor k >= 2 (k x k samples a pixel, e.g. anti_aliasing=2), or one of PyVista's 'ssaa', 'fxaa', 'msaa'.
+    """
+    if value is None or value is False:
+        return None, 1
+    if isinstance(value, str) and value in ("ssaa", "fxaa", "msaa"):
+        return value, 1
+    if not isinstance(value, bool) and isinstance(value, (int, np.integer)) and 1 <= value <= 8:
+        return None, int(value)
+    raise ValueError(f"anti_aliasing={value!r} is " + ("ambiguous" if value is True else "not known") + ": give "
+                     "False, a supersampling factor k >= 2 (k x k samples a pixel, e.g. anti_aliasing=2), or one of "
+                     "PyVista's 'ssaa', 'fxaa', 'msaa'.")
+
+
 def _check_window_size(window_size) -> None:
     """ValueError unless ``window_size`` is two positive ints ``(width, height)``.
 
@@ -74,8 +94,19 @@ def _check_window_size(window_size) -> None:
 class Plotter(pv.Plotter):
     """A :class:`pyvista.Plotter` with :meth:`add_spline`; everything else is PyVista's.
 
-    Anti-aliasing is off unless asked for: the ray-cast programs shade each pixel once, and exact
-    readback (depth, colours) and timings need single-sample buffers.
+    Parameters
+    ----------
+    anti_aliasing : False, int or {"ssaa", "fxaa", "msaa"}, default False
+        How silhouettes are smoothed, for spline actors and meshes alike (the stripes of reflection lines,
+        isophotes and highlight lines are filtered in the shader whatever this is, ``Style.antialias``):
+
+        * ``False`` -- one sample per pixel: exact readback (depth, colours) and timings need single-sample
+          buffers.
+        * an int ``k >= 2`` -- supersampling: :meth:`screenshot` renders the whole scene (every actor, depth
+          compositing intact) at ``k`` times the window's width and height and averages each ``k x k`` block,
+          ``k^2`` samples a pixel at ``k^2`` times the fragments.
+        * ``"ssaa"``, ``"fxaa"``, ``"msaa"`` -- PyVista's :meth:`~pyvista.Plotter.enable_anti_aliasing` (VTK's
+          render passes; on the OSMesa/EGL builds of VTK, PyVista draws ``"fxaa"`` as ``"ssaa"``).
 
     Examples
     --------
@@ -88,20 +119,59 @@ class Plotter(pv.Plotter):
     >>> image = pl.screenshot()
     >>> image.shape
     (240, 320, 3)
+
+    Supersampled 2 x 2: the same picture size, smooth silhouettes.
+
+    >>> pl = splinevis.Plotter(off_screen=True, window_size=(160, 120), anti_aliasing=2)
+    >>> actor = pl.add_spline(QuarticTrianglePatch.demo(), reflection_lines=10)
+    >>> pl.screenshot().shape
+    (120, 160, 3)
     """
 
     _gl_checked = False
     _spline_actors: tuple = ()
+    _supersample = 1
 
-    def __init__(self, *args, anti_aliasing: bool = False, **kwargs):
+    def __init__(self, *args, anti_aliasing=False, **kwargs):
         if kwargs.get("window_size") is not None:
             _check_window_size(kwargs["window_size"])
+        kind, factor = _anti_aliasing_choice(anti_aliasing)
         super().__init__(*args, **kwargs)
-        if not anti_aliasing:
+        self._supersample = factor
+        if kind is None:
             self.disable_anti_aliasing()
             self.render_window.SetMultiSamples(0)  # before the first render: single-sample buffers
+        else:
+            self.enable_anti_aliasing(kind)
         self._spline_actors: list[SplineActor] = []
         self._gl_checked = False
+
+    def screenshot(self, filename=None, transparent_background=None, return_img=True, window_size=None,
+                   scale=None):
+        """PyVista's :meth:`~pyvista.Plotter.screenshot`; with ``anti_aliasing=k`` the scene is rendered at
+        ``k`` times the size and each ``k x k`` block averaged (rounded to the nearest 8-bit level).
+
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> pl = Plotter(off_screen=True, window_size=(40, 30), anti_aliasing=3)
+        >>> _ = pl.add_spline(QuarticTrianglePatch.demo())
+        >>> pl.screenshot().shape
+        (30, 40, 3)
+        """
+        k = self._supersample
+        if k == 1:
+            return super().screenshot(filename, transparent_background=transparent_background, return_img=return_img,
+                                      window_size=window_size, scale=scale)
+        w, h = (int(v) for v in (window_size if window_size is not None else self.window_size))
+        big = np.asarray(super().screenshot(None, transparent_background=transparent_background, return_img=True,
+                                            window_size=(w * k, h * k), scale=scale))
+        s = int(scale or 1)
+        blocks = big.reshape(h * s, k, w * s, k, big.shape[-1]).astype(np.float64)
+        img = pv.pyvista_ndarray(np.rint(blocks.mean(axis=(1, 3))).astype(np.uint8))
+        if filename:
+            from PIL import Image
+
+            Image.fromarray(np.asarray(img)).save(filename)
+        return img if return_img else None
 
     def __del__(self):
         if "_initialized" not in self.__dict__:  # __init__ refused its arguments before pyvista set up
@@ -146,7 +216,7 @@ class Plotter(pv.Plotter):
         >>> actor = pl.add_spline(QuarticTrianglePatch.demo(), lights=2, reflection_lines=8,
         ...                       program_options={"roots": "paper"})
         >>> actor.program.name, sorted(actor.style.effect_set()), actor.spec.defines["SV_ROOTS_PAPER"]
-        ('analytic_patch', ['lights', 'reflection_lines'], True)
+        ('analytic_patch', ['antialias', 'lights', 'reflection_lines'], True)
         >>> pl.add_spline(QuarticTrianglePatch.demo(), reflection_line=8)
         Traceback (most recent call last):
         TypeError: unknown effect or style option 'reflection_line' (did you mean 'reflection_lines'?); known: ...

@@ -4,7 +4,8 @@ kinds) per pixel against the same formula on the float64 twin's hits (points and
 A ray-cast sphere isosurface is the test object: its twin gives every pixel's exact hit, and the effects'
 GLSL runs unchanged for every family. Pixels whose twin value lies within a small margin of a colour
 boundary may fall either way (float32 normals, sub-pixel sampling) and are left out; the margin is stated
-with each test.
+with each test. The stripe tests draw the plain step (``antialias=False``): they test where the stripes are;
+tests/test_stripes_antialias.py tests their filter.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def sphere():
 @pytest.mark.parametrize("axis", [(1.0, 0.0, 0.0), (0.3, -0.5, 0.8)])
 def test_reflection_lines_about_any_axis_match_the_twin(sphere, axis):
     stripes = 6
-    img, matrix = _render(sphere, reflection_lines=stripes, reflection_axis=axis)
+    img, matrix = _render(sphere, reflection_lines=stripes, reflection_axis=axis, antialias=False)
     bright, hit, dist = zebra_reference(sphere, matrix, WINDOW, stripes, axis)
     # the stripe phase moves by (2 stripes / pi) * |dr| with |dr| <= 2 |dn|: margin in phase units
     ok = hit & (dist > 4 * stripes / np.pi * ANGLE_MARGIN)
@@ -87,7 +88,7 @@ def test_reflection_axis_changes_the_picture(sphere):
 
 def test_highlight_lines_match_the_twin(sphere):
     spacing, height = 0.35, 1.5  # the actor's offset (-1, -1, -1) is no whole number of spacings
-    img, matrix = _render(sphere, highlight_lines=spacing, highlight_height=height)
+    img, matrix = _render(sphere, highlight_lines=spacing, highlight_height=height, antialias=False)
     hits, _ = _twin(sphere, matrix)
     p, n = hits.points, hits.normals / np.linalg.norm(hits.normals, axis=-1, keepdims=True)
     m, across = np.array([0.0, 0.0, 1.0]), np.cross([0.0, 0.0, 1.0], [1.0, 0.0, 0.0])  # W = (0, 1, 0)
@@ -106,13 +107,13 @@ def test_highlight_lines_match_the_twin(sphere):
 def test_highlight_lines_do_not_depend_on_the_eye(sphere):
     # the band of a surface point is a function of the point alone: the +z pole seen from two eyes is in the
     # same band (w = 0 there: on a band edge, so look just beside it, at the twin's hits of two views)
-    a, ma = _render(sphere, highlight_lines=0.5, highlight_height=1.5)
+    a, ma = _render(sphere, highlight_lines=0.5, highlight_height=1.5, antialias=False)
     hits_a, _ = _twin(sphere, ma)
     global CAMERA
     saved = CAMERA
     CAMERA = [(3.0, 0.2, 2.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
     try:
-        b, mb = _render(sphere, highlight_lines=0.5, highlight_height=1.5)
+        b, mb = _render(sphere, highlight_lines=0.5, highlight_height=1.5, antialias=False)
         hits_b, _ = _twin(sphere, mb)
     finally:
         CAMERA = saved
@@ -177,5 +178,6 @@ def test_interrogation_style_errors():
         splinevis.Style(reflection_lines=4, reflection_axis=(0, 0, 0))
     # only what is declared is compiled in
     assert splinevis.Style(highlight_lines=0.2).include_files() == ["lib/effects/lights.glsl",
-                                                                   "lib/effects/highlight_lines.glsl"]
+                                                                   "lib/effects/highlight_lines.glsl",
+                                                                   "lib/effects/stripes.glsl"]
     assert splinevis.Style(output="draft").include_files() == ["lib/effects/draft.glsl"]

@@ -81,7 +81,7 @@ def test_broken_glsl_raises_with_log_and_source(tmp_path, monkeypatch):
 
     shutil.copytree(asm.glsl_root(), root)
     bad = root / "lib" / "effects" / "isophotes.glsl"
-    bad.write_text(bad.read_text().replace("return fract", "return undeclared_thing + fract"))
+    bad.write_text(bad.read_text().replace("return mix(", "return undeclared_thing + mix("))
     monkeypatch.setattr(asm, "glsl_root", lambda: root)
     asm._assemble_cached.cache_clear()
     try:
@@ -95,7 +95,7 @@ def test_broken_glsl_raises_with_log_and_source(tmp_path, monkeypatch):
     err = info.value
     assert err.stage == "fragment"
     assert any(where and where.startswith("lib/effects/isophotes.glsl:") for _, _, where in err.locations)
-    assert "undeclared_thing + fract" in str(err)
+    assert "undeclared_thing + mix(" in str(err)
 
 
 def test_add_spline_rejects_unknown_options_and_models():

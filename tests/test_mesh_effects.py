@@ -204,7 +204,8 @@ def test_reflection_lines_keep_their_public_function():
     # a study's call: pyvista colours as 0..255 triples, flat white stripes (ambient 1) 1.0 and 0.15 on black
     pl = splinevis.Plotter(off_screen=True, window_size=(64, 64))
     pl.set_background("black")
-    actor = add_mesh_with_reflection_lines(pl, pv.Sphere(), 8, color=(255, 255, 255), ambient=1.0, diffuse=0.0)
+    actor = add_mesh_with_reflection_lines(pl, pv.Sphere(), 8, color=(255, 255, 255), ambient=1.0, diffuse=0.0,
+                                           antialias=False)  # the plain step: two colours exactly
     img = pl.screenshot().astype(int)
     pl.close()
     assert "sv_reflection_lines(" in actor.program_sources["fragment"]

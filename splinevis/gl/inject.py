@@ -47,15 +47,18 @@ _FS_DEC = """//VTK::Edges::Dec
 in vec3 svPosMC;
 uniform mat4 MCDCMatrix;
 """
+# With SV_ANTIALIAS a miss is shaded too, flagged, and discarded after: the stripes' filter differentiates across
+# the 2 x 2 pixel quad (lib/effects/stripes.glsl).
+_FS_MISS = "#ifdef SV_ANTIALIAS\n  sv_stripe_valid = sv_is_hit ? 1.0 : 0.0;\n#else\n  if (!sv_is_hit) discard;\n#endif\n"
+_FS_SHADE = "  vec4 sv_out = sv_shade(sv_hit, sv_rd);\n#ifdef SV_ANTIALIAS\n  if (!sv_is_hit) discard;\n#endif\n"
 _FS_DEPTH = """
   vec3 sv_ro; vec3 sv_rd; float sv_tmin;
   sv_pixel_ray(svPosMC, sv_ro, sv_rd, sv_tmin);
   SvHit sv_hit;
-  if (!sv_surface_hit(sv_ro, sv_rd, sv_tmin, sv_hit)) discard;
-  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_ro + sv_hit.t * sv_rd);
+  bool sv_is_hit = sv_surface_hit(sv_ro, sv_rd, sv_tmin, sv_hit);
+""" + _FS_MISS + """  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_ro + sv_hit.t * sv_rd);
   gl_FragDepth = sv_hit.depth;
-  vec4 sv_out = sv_shade(sv_hit, sv_rd);
-"""
+""" + _FS_SHADE
 # The "surface" kind: the rasterized mesh carries surface parameters; the program's sv_surface_eval evaluates
 # the surface exactly at this fragment's parameters (no ray search). The view ray of the fragment still
 # decides two-sided shading and reflections.
@@ -63,11 +66,10 @@ _FS_SURFACE = """
   vec3 sv_ro; vec3 sv_rd; float sv_tmin;
   sv_pixel_ray(svPosMC, sv_ro, sv_rd, sv_tmin);
   SvHit sv_hit;
-  if (!sv_surface_eval(svPosMC, sv_hit)) discard;
-  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_hit.pos);
+  bool sv_is_hit = sv_surface_eval(svPosMC, sv_hit);
+""" + _FS_MISS + """  sv_hit.depth = sv_window_depth(MCDCMatrix, sv_hit.pos);
   gl_FragDepth = sv_hit.depth;
-  vec4 sv_out = sv_shade(sv_hit, sv_rd);
-"""
+""" + _FS_SHADE
 _FS_LIGHT = """  fragOutput0 = sv_out;
 """
 # The debug build with per-fragment counters (SV_DEBUG_COUNTERS, glsl/lib/core/counters.glsl): a miss is not

@@ -31,7 +31,7 @@ from .inject import _set_uniform, camera_frame
 __all__ = ["add_mesh_with_reflection_lines", "add_mesh_with_effects", "MESH_EFFECTS", "CURVATURE_ARRAY"]
 
 #: Style effects a mesh made by a ``passes`` or ``mesh`` program can show.
-MESH_EFFECTS = frozenset({"lights", "reflection_lines", "isophotes", "transparency", "curvature"})
+MESH_EFFECTS = frozenset({"lights", "reflection_lines", "isophotes", "antialias", "transparency", "curvature"})
 #: Point-data array of (mean H, Gaussian K) per vertex that ``output="curvature"`` shows on a mesh.
 CURVATURE_ARRAY = "curvature"
 # The effects drawn by fragment code of ours (the others are VTK's lighting and opacity), in the order
@@ -84,6 +84,8 @@ def _replacements(effects) -> list[tuple[str, str, str]]:
     for name in shown:
         files.append(EFFECTS[name][1])
         defines[EFFECTS[name][0]] = True
+    if "antialias" in effects and shown:  # the stripes averaged over the pixel, as on the spline programs
+        defines[EFFECTS["antialias"][0]] = True
     code = assemble("".join(f'#include "{f}"\n' for f in files), defines).text if files else ""
     vs_dec, vs_impl, fs_dec = _VS_DEC, _VS_IMPL, _FS_DEC
     if "isophotes" in shown:
@@ -195,11 +197,11 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
 
 
 def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", ambient: float = 0.15,
-                                   diffuse: float = 0.85, axis=(1.0, 0.0, 0.0)):
+                                   diffuse: float = 0.85, axis=(1.0, 0.0, 0.0), antialias: bool = True):
     """Add ``mesh`` (point normals are used, e.g. from marching cubes; computed if absent) to ``plotter``,
     Phong-shaded with VTK's lights, with ``stripes`` reflection lines computed as for the splines
-    (``Style(reflection_lines=stripes, reflection_axis=axis)``). The mesh is in world coordinates (no actor
-    transform).
+    (``Style(reflection_lines=stripes, reflection_axis=axis, antialias=antialias)``: filtered over the pixel
+    unless ``antialias`` is False). The mesh is in world coordinates (no actor transform).
 
     Returns the vtkActor. (A vtkOpenGLPolyDataMapper of our own: pyvista's DataSetMapper renders through
     an internal mapper whose shader events it does not forward.) This is :func:`add_mesh_with_effects` with
@@ -221,7 +223,7 @@ def add_mesh_with_reflection_lines(plotter, mesh, stripes: int, *, color="tan", 
     if isinstance(stripes, bool) or not isinstance(stripes, (int, np.integer)) or stripes < 1:
         raise ValueError(f"stripes must be a positive integer, got {stripes!r}.")
     style = Style(lights=1, color=pv.Color(color).float_rgb, reflection_lines=int(stripes), reflection_axis=axis,
-                  ambient=ambient, diffuse=diffuse)
+                  ambient=ambient, diffuse=diffuse, antialias=antialias)
     return _add_shaded_mesh(plotter, mesh, style)
 
 
@@ -262,7 +264,7 @@ def add_mesh_with_effects(plotter, mesh, style, *, name=None):
     ValueError: Style(output='curvature') on a mesh shows its point-data array 'curvature' of (mean H, Gaussian K) per vertex; this mesh has none. Add it from the surface the mesh samples, or estimate it from the mesh: mesh.point_data['curvature'] = np.column_stack([mesh.curvature('mean'), mesh.curvature('gaussian')]).
     >>> add_mesh_with_effects(pl, pv.Sphere(), Style(output="normals"))
     Traceback (most recent call last):
-    ValueError: a mesh-drawing program cannot show the effects normals yet; it shows curvature, isophotes, lights, reflection_lines, transparency. Remove them from the Style.
+    ValueError: a mesh-drawing program cannot show the effects normals yet; it shows antialias, curvature, isophotes, lights, reflection_lines, transparency. Remove them from the Style.
     >>> pl.close()
     """
     effects = style.effect_set()

@@ -1,7 +1,9 @@
-// Isophotes: curves of constant dot(n, L) for the first light, drawn as alternating bands.
+// Isophotes: curves of constant dot(n, L) for the first light, drawn as alternating bands (dark 0.2, bright 1),
+// filtered over the pixel with SV_ANTIALIAS (lib/effects/stripes.glsl).
+#include "lib/effects/stripes.glsl"
 uniform float sv_isophote_bands;
 
 float sv_isophotes(vec3 n) {
-    float c = clamp(dot(n, sv_light_dir[0]), -1.0, 1.0);
-    return fract(c * sv_isophote_bands) < 0.5 ? 0.2 : 1.0;
+    float x = clamp(dot(n, sv_light_dir[0]), -1.0, 1.0) * sv_isophote_bands;
+    return mix(0.2, 1.0, sv_stripe_bright(x, sv_stripe_width(x)));
 }
