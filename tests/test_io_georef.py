@@ -327,3 +327,39 @@ def test_a_target_crs_that_cannot_hold_the_grid_is_our_error():
         with pytest.raises(ValueError, match=r"dem\.tif: (PROJ cannot take the grid's coordinates from EPSG:4326 to "
                                              r"|)\+proj=ortho.*(cannot hold the grid's footprint|).*another crs="):
             to_metric(lat, (0.1, 0.1), (170.0, 45.0), "EPSG:4326", target=ortho, fill=fill, source="dem.tif")
+
+
+def _ascii_grid_in_degrees(path, n=30):
+    """An ESRI ASCII grid of heights in metres on a lattice of degrees (lon -105.55.., lat 40.09..), no .prj."""
+    rows = "\n".join(" ".join(f"{2000.0 + 10.0 * i + j:.1f}" for j in range(n)) for i in range(n))
+    path.write_text(f"ncols {n}\nnrows {n}\nxllcorner -105.55\nyllcorner 40.09\ncellsize 0.000833333333\n"
+                    f"NODATA_value -9999\n{rows}\n")
+    return path
+
+
+def test_degrees_without_a_crs_are_warned_and_source_crs_places_them(tmp_path):
+    from splinevis.io import read_heights
+
+    path = _ascii_grid_in_degrees(tmp_path / "srtm.asc")
+    with pytest.warns(UserWarning, match=r"look like degrees .* pass source_crs='EPSG:4326'"):
+        plain = read_heights(path)
+    assert plain.crs is None and plain.extent[1] - plain.extent[0] < 0.03  # degrees read as metres: a needle
+    g = read_heights(path, source_crs="EPSG:4326", fill="nearest")
+    assert g.crs == "EPSG:32613"  # UTM zone 13 holds lon -105.5
+    # 29 steps of 3 arc-seconds: 2.21 km east-west at lat 40.1 (cos 40.1 * 111.32 km / degree), 2.68 km
+    # north-south; the new lattice holds whole steps of its own spacing: within two of them
+    x0, x1, y0, y1 = g.extent
+    assert abs((x1 - x0) - 29 * 0.000833333333 * 111_320 * np.cos(np.radians(40.1))) < 2 * g.spacing[0]
+    assert abs((y1 - y0) - 29 * 0.000833333333 * 111_000) < 2 * g.spacing[1]
+
+
+def test_source_crs_is_for_grids_that_name_none(tmp_path):
+    from datasets_synthetic.dem_files import write_geotiff
+    from splinevis.io import read_heights
+
+    tif = tmp_path / "utm.tif"
+    write_geotiff(tif, np.zeros((4, 5)), (30.0, 30.0), (500_000.0, 5_000_000.0), epsg=32633)
+    with pytest.raises(ValueError, match="source_crs='EPSG:4326' is for grids that name no CRS; this one names"):
+        read_heights(tif, source_crs="EPSG:4326")
+    with pytest.raises(ValueError, match=r"source_crs='EPSG:99999' is not a known CRS"):
+        read_heights(np.zeros((3, 3)), spacing=(1.0, 1.0), origin=(0.0, 0.0), source_crs="EPSG:99999")

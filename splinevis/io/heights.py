@@ -174,7 +174,8 @@ class HeightGrid:
 # Public entry point
 # --------------------------------------------------------------------------------------------------
 def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None, fill=None,
-                 resample=False, band=1, crs=None, keep_geographic=False, reproject="bilinear") -> HeightGrid:
+                 resample=False, band=1, crs=None, keep_geographic=False, reproject="bilinear",
+                 source_crs=None) -> HeightGrid:
     """Read height data into a :class:`HeightGrid`.
 
     Parameters
@@ -208,6 +209,11 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
         at its centre latitude (stated in ``source``; true there only).
     reproject : {"bilinear", "cubic", "nearest"}
         How the heights are interpolated when a geographic grid is reprojected.
+    source_crs : str, optional
+        The CRS the grid is in when the source names none (an ASCII grid without its ``.prj``, an array): e.g.
+        ``"EPSG:4326"`` for longitudes and latitudes, which are then projected like any geographic grid
+        (``crs=`` is the CRS to project *to*). A source that names another CRS raises ValueError. A grid that
+        names none but whose x, y look like degrees under heights of metres is warned about.
 
     Returns
     -------
@@ -249,7 +255,35 @@ def read_heights(source, *, scalars=None, spacing=None, origin=None, nodata=None
         origin = check_geometry(origin, "origin", axes=2)
 
     samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, nodata=nodata, band=band)
-    return _georeference(_finish(samples, fill=fill, resample=resample), crs, keep_geographic, reproject, fill)
+    grid = _with_source_crs(_finish(samples, fill=fill, resample=resample), source_crs)
+    return _georeference(grid, crs, keep_geographic, reproject, fill)
+
+
+def _with_source_crs(grid: HeightGrid, source_crs) -> HeightGrid:
+    """``grid`` with ``source_crs`` as its CRS where it names none; a warning where it names none and its x, y
+    look like degrees (inside +-180 x +-90, steps under 0.1) under a relief 100 times the footprint's width."""
+    from dataclasses import replace
+
+    from .georef import _crs
+
+    if source_crs is not None:
+        wanted = _crs(source_crs, grid.source, f"source_crs={source_crs!r}")
+        if grid.crs is None:
+            return replace(grid, crs=wanted.to_string())
+        if _crs(grid.crs, grid.source) != wanted:
+            raise ValueError(f"{grid.source}: source_crs={source_crs!r} is for grids that name no CRS; this one names "
+                             f"{grid.crs}. Drop source_crs (crs= reprojects a geographic grid to another CRS).")
+        return grid
+    x0, x1, y0, y1 = grid.extent
+    degrees = -180.0 <= x0 and x1 <= 360.0 and -90.0 <= y0 and y1 <= 90.0 and max(grid.spacing) < 0.1
+    if grid.crs is None and degrees and float(np.ptp(grid.heights)) > 100.0 * max(x1 - x0, y1 - y0):
+        from .._warnings import warn_user
+
+        warn_user(f"{grid.source}: names no CRS, and its x, y ({x0:.6g}..{x1:.6g}, {y0:.6g}..{y1:.6g}, steps "
+                  f"{grid.spacing[0]:.3g} x {grid.spacing[1]:.3g}) look like degrees under heights {np.ptp(grid.heights):.4g} "
+                  "high: drawn as they are, the terrain is a needle. If they are longitudes and latitudes, pass "
+                  "source_crs='EPSG:4326' (or put the .prj file beside it).")
+    return grid
 
 
 def _georeference(grid: HeightGrid, crs, keep_geographic, reproject, fill=None) -> HeightGrid:

@@ -31,7 +31,7 @@ __all__ = ["JUDGE"]
 def _read(path, options, findings):
     from ..io import read_heights
 
-    kw = {k: options[k] for k in ("scalars", "band", "crs") if k in options}
+    kw = {k: options[k] for k in ("scalars", "band", "crs", "source_crs") if k in options}
     grid = read_heights(path, fill="nearest", **kw)
     return grid
 
@@ -155,7 +155,8 @@ def _accuracy(path, grid, model, baseline, options, findings):
     if relief > 100 * width:  # a needle: horizontal units are not the heights' (degrees read as metres)
         findings.append(Finding("FAIL", f"the grid is {width:.4g} wide and {relief:.4g} high (x/y and heights in "
                                         "different units?): degrees without a coordinate system, drawn as a needle; "
-                                        "pass the CRS (read option crs=...)"))
+                                        "pass the CRS they are in (read_heights(path, source_crs='EPSG:4326')) or "
+                                        "put the .prj file beside it"))
     r = reader_against_file(path, grid, options.get("band", 1))
     if r is None:
         findings.append(Finding("WARN", "GDAL cannot open the file: the reader is not checked against an "
