@@ -19,8 +19,9 @@ environment     reflection of a latitude-longitude environment image
 reflection_lines  stripes of a family of parallel light lines seen in the mirrored view ray (zebra)
 highlight_lines   bands where the surface normal line meets one of a family of linear lights (view-independent)
 isophotes       stripes of constant ``dot(n, L)``
-antialias       the stripes above averaged over each pixel's footprint (on by default whenever a stripe
-                effect is declared; ``antialias=False`` gives the plain step)
+antialias       the stripes above averaged over each pixel's footprint, the specular lobe widened by the
+                spread of the normals over it (on by default whenever a stripe effect or specular is
+                declared; ``antialias=False`` gives one sample's shading)
 transparency    ``opacity < 1``: alpha output, composited by VTK's translucent pass
 normals         output colour = encoded unit normal ``0.5 * (n + 1)`` (replaces shading)
 curvature       output colour = a curvature (mean, Gaussian, principal) through a diverging colormap
@@ -56,7 +57,7 @@ EFFECTS: dict[str, tuple[str, str]] = {
     "reflection_lines": ("SV_REFLECTION_LINES", "lib/effects/reflection_lines.glsl"),
     "highlight_lines": ("SV_HIGHLIGHT_LINES", "lib/effects/highlight_lines.glsl"),
     "isophotes": ("SV_ISOPHOTES", "lib/effects/isophotes.glsl"),
-    "antialias": ("SV_ANTIALIAS", "lib/effects/stripes.glsl"),
+    "antialias": ("SV_ANTIALIAS", "lib/effects/footprint.glsl"),
     "transparency": ("SV_TRANSPARENCY", "lib/effects/transparency.glsl"),
     "normals": ("SV_OUT_NORMALS", "lib/effects/normals.glsl"),
     "curvature": ("SV_OUT_CURVATURE", "lib/effects/curvature.glsl"),
@@ -64,7 +65,7 @@ EFFECTS: dict[str, tuple[str, str]] = {
     "depth": ("SV_OUT_DEPTH", "lib/effects/depth.glsl"),
 }
 
-#: The effects drawn as light/dark stripes of a smooth quantity (``glsl/lib/effects/stripes.glsl``), which
+#: The effects drawn as light/dark stripes of a smooth quantity (``glsl/lib/effects/footprint.glsl``), which
 #: ``Style.antialias`` filters over the pixel.
 STRIPE_EFFECTS = ("reflection_lines", "highlight_lines", "isophotes")
 
@@ -152,9 +153,11 @@ class Style:
         Number of isophote bands of ``dot(n, L)`` for the first light direction.
     antialias : bool, default True
         Average the stripes of reflection lines, highlight lines and isophotes over each pixel's footprint
-        (from the screen-space derivatives of the stripe coordinate; ``glsl/lib/effects/stripes.glsl``): a
-        stripe narrower than a pixel fades to its mean instead of aliasing into a moire. False draws the
-        plain step, one sample per pixel. Compiled in only with a stripe effect.
+        (from the screen-space derivatives of the stripe coordinate; ``glsl/lib/effects/footprint.glsl``): a
+        stripe narrower than a pixel fades to its mean instead of aliasing into a moire; and widen the
+        specular highlight by the spread of the normals over the pixel [Toksvig2005], so a highlight narrower
+        than a pixel does not sparkle. False draws the plain step and the one-normal highlight. Compiled in
+        only with a stripe effect or specular.
     output : {"normals", "curvature", "draft", "depth"}, optional
         Replace shading by an analysis output.
     curvature : {"mean", "gaussian", "k1", "k2", "max"}, default "mean"
@@ -291,7 +294,7 @@ class Style:
                 on.add(name)
         if self.opacity < 1:
             on.add("transparency")
-        if self.antialias and on.intersection(STRIPE_EFFECTS):
+        if self.antialias and (on.intersection(STRIPE_EFFECTS) or "specular" in on):
             on.add("antialias")
         return frozenset(on)
 
@@ -301,7 +304,7 @@ class Style:
         Examples
         --------
         >>> sorted(Style(lights=2, specular=True).defines().items())
-        [('SV_NUM_LIGHTS', 2), ('SV_SPECULAR', True)]
+        [('SV_ANTIALIAS', True), ('SV_NUM_LIGHTS', 2), ('SV_SPECULAR', True)]
         """
         out = {}
         for name in self.effect_set():
@@ -315,7 +318,7 @@ class Style:
         Examples
         --------
         >>> Style(lights=2, specular=True, reflection_lines=12).include_files()
-        ['lib/effects/lights.glsl', 'lib/effects/reflection_lines.glsl', 'lib/effects/stripes.glsl']
+        ['lib/effects/lights.glsl', 'lib/effects/reflection_lines.glsl', 'lib/effects/footprint.glsl']
         """
         files = []
         for name in EFFECTS:

@@ -44,6 +44,8 @@ WITHOUT_EXAMPLES = {
     # fit and six panels, three of them offscreen scenes of 360x300)
     "splinevis.studies.geometry_image": {"run_geometry_image_study"},
     "splinevis.studies.geometry_image_figures": {"pipeline_figure"},
+    # the antialiasing study: six offscreen renders per scene and renderer, four scenes (25 s with quick=True)
+    "splinevis.studies.antialiasing": {"run_antialiasing_study"},
 }
 
 

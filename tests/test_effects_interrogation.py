@@ -179,5 +179,5 @@ def test_interrogation_style_errors():
     # only what is declared is compiled in
     assert splinevis.Style(highlight_lines=0.2).include_files() == ["lib/effects/lights.glsl",
                                                                    "lib/effects/highlight_lines.glsl",
-                                                                   "lib/effects/stripes.glsl"]
+                                                                   "lib/effects/footprint.glsl"]
     assert splinevis.Style(output="draft").include_files() == ["lib/effects/draft.glsl"]

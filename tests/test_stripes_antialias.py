@@ -1,5 +1,5 @@
-"""Stripes filtered over the pixel (glsl/lib/effects/stripes.glsl): the GLSL average against its float64 twin
-(splinevis.analysis.stripes) within the derived float32 bound, and a reflection-line pattern finer than a pixel
+"""Stripes filtered over the pixel (glsl/lib/effects/footprint.glsl): the GLSL average against its float64 twin
+(splinevis.analysis.footprint) within the derived float32 bound, and a reflection-line pattern finer than a pixel
 rendering to its mean grey (a moire without the filter)."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import splinevis
-from splinevis.analysis.stripes import MAX_WIDTH, MIN_WIDTH, float32_bound, mean_deviation_bound, stripe_bright
+from splinevis.analysis.footprint import MAX_WIDTH, MIN_WIDTH, float32_bound, mean_deviation_bound, stripe_bright
 from splinevis.analysis.zebra import reflection_phase
 from splinevis.gl.camera import pixel_rays
 from splinevis.gl.harness import run_glsl
@@ -22,7 +22,7 @@ pytestmark = pytest.mark.gl
 
 def _glsl_bright(x, w, antialias=True):
     rows = np.column_stack([x, w]).astype(np.float32)
-    out = run_glsl('#include "lib/effects/stripes.glsl"\n', "sv_out[0] = sv_stripe_bright(sv_in[0], sv_in[1]);",
+    out = run_glsl('#include "lib/effects/footprint.glsl"\n', "sv_out[0] = sv_stripe_bright(sv_in[0], sv_in[1]);",
                    rows, 1, defines={"SV_ANTIALIAS": True} if antialias else None)
     return out[:, 0].astype(np.float64), rows.astype(np.float64)
 
@@ -38,7 +38,7 @@ def test_filtered_stripe_matches_the_float64_twin():
     xs, ws = rows[:, 0], rows[:, 1]
     twin = stripe_bright(xs, ws)
     filtered = (ws >= MIN_WIDTH) & (ws < MAX_WIDTH)
-    # the derived bound of the float32 operations (splinevis.analysis.stripes.float32_bound)
+    # the derived bound of the float32 operations (splinevis.analysis.footprint.float32_bound)
     assert np.all(np.abs(g - twin)[filtered] <= float32_bound(ws[filtered]))
     assert np.array_equal(g[~filtered], twin[~filtered])  # the step (exact) and the mean (exact)
     assert g[1] == 0.5 and g[5] == 0.5 and g[6] == 0.5     # astride an edge; beyond MAX_WIDTH; not finite
@@ -106,7 +106,7 @@ def test_stripes_finer_than_a_pixel_render_to_their_mean():
     # mean. The shader's footprint is the same difference taken in the pixel's 2 x 2 quad, up to a pixel away:
     # we allow it to be half the twin's (1/8), plus 8-bit rounding of the picture. A pixel whose two quad
     # partners both lie outside the proxy primitive drawn (a corner of a block of cubes) has no neighbour
-    # that hit and keeps its point sample (lib/effects/stripes.glsl): 2.4 % of these pixels in this view.
+    # that hit and keeps its point sample (lib/effects/footprint.glsl): 2.4 % of these pixels in this view.
     fine = ok & (w >= 4.0)
     assert fine.sum() > 0.5 * ok.sum()  # most of the sphere: the case is not empty
     mean = 0.15 + 0.85 * 0.5
@@ -116,3 +116,25 @@ def test_stripes_finer_than_a_pixel_render_to_their_mean():
     assert (dev_filtered <= tol).mean() >= 0.95
     # one sample per pixel: every pixel is dark or bright, 0.425 from the mean -- a moire, and the check fails
     assert np.quantile(dev_plain, 0.5) > tol
+
+
+def test_toksvig_factor_from_the_quad_derivatives_matches_the_twin():
+    # Normals turning about y by k per pixel along x (the same turn for both rows of each 2 x 2 quad, so coarse
+    # and fine derivatives agree): |dn/dX| = 2 sin(k / 2) exactly, dn/dY = 0.
+    from splinevis.analysis.footprint import toksvig_factor
+
+    side, s = 64, 40.0
+    px, py = np.meshgrid(np.arange(side), np.arange(side))
+    k = 0.03 * (1 + py // 2)  # 0.03 .. 0.96 rad a pixel
+    n = np.stack([np.sin(0.3 + k * px), np.zeros_like(k, dtype=float), np.cos(0.3 + k * px)], axis=-1)
+    rows = n.reshape(-1, 3).astype(np.float32)
+    out = run_glsl('uniform float sv_ambient;\nuniform float sv_diffuse;\n#include "lib/effects/lights.glsl"\n',
+                   "sv_out[0] = sv_toksvig_factor(vec3(sv_in[0], sv_in[1], sv_in[2]), 40.0);", rows, 1,
+                   defines={"SV_NUM_LIGHTS": 1, "SV_SPECULAR": True, "SV_ANTIALIAS": True})[:, 0].astype(np.float64)
+    step = (2 * np.sin(k / 2)).ravel()
+    twin = toksvig_factor(np.stack([step, 0 * step, 0 * step], -1), np.zeros((step.size, 3)), s)
+    # float32: each normal's components round by u, so |dn| by <= 4u and the variance by <= |dn| 8u / 12; ft's
+    # slope in the variance is at most s / 2 (its denominator is >= 1 for s >= 1); plus ~16 roundings of ft
+    u = 2.0**-24
+    assert np.all(np.abs(out - twin) <= s / 2 * step * 8 * u / 12 + 16 * u * (1 + s))
+    assert twin.min() < 0.5 < twin.max()  # the range spans a barely and a strongly widened highlight

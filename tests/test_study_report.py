@@ -144,18 +144,18 @@ def test_no_study_imports_another_studys_privates():
 def test_the_list_of_studies_drives_the_cli(capsys):
     from splinevis.cli import main
 
-    assert list(STUDIES) == ["terrain", "volume", "nurbs", "walkthrough", "geometry-image"]
+    assert list(STUDIES) == ["terrain", "volume", "nurbs", "walkthrough", "geometry-image", "antialiasing"]
     assert get("terrain").runner == "splinevis.studies.terrain:run_terrain_study"
     for study in STUDIES.values():
         module, _, function = study.runner.partition(":")
         assert callable(getattr(__import__(module, fromlist=[function]), function))
         assert study.json_file("out").name == f"{study.name}.json"
-    with pytest.raises(ValueError, match="study 'x' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough', 'geometry-image'."):
+    with pytest.raises(ValueError, match="study 'x' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough', 'geometry-image', 'antialiasing'."):
         get("x")
     with pytest.raises(SystemExit) as exc:
         main(["study", "--help"])
     assert exc.value.code == 0
-    assert "{terrain,volume,nurbs,walkthrough,geometry-image}" in capsys.readouterr().out
+    assert "{terrain,volume,nurbs,walkthrough,geometry-image,antialiasing}" in capsys.readouterr().out
     with pytest.raises(SystemExit) as exc:
         main(["study", "sphere", "--out", "x"])
     assert exc.value.code == 2

@@ -48,8 +48,8 @@ in vec3 svPosMC;
 uniform mat4 MCDCMatrix;
 """
 # With SV_ANTIALIAS a miss is shaded too, flagged, and discarded after: the stripes' filter differentiates across
-# the 2 x 2 pixel quad (lib/effects/stripes.glsl).
-_FS_MISS = "#ifdef SV_ANTIALIAS\n  sv_stripe_valid = sv_is_hit ? 1.0 : 0.0;\n#else\n  if (!sv_is_hit) discard;\n#endif\n"
+# the 2 x 2 pixel quad (lib/effects/footprint.glsl).
+_FS_MISS = "#ifdef SV_ANTIALIAS\n  sv_footprint_valid = sv_is_hit ? 1.0 : 0.0;\n#else\n  if (!sv_is_hit) discard;\n#endif\n"
 _FS_SHADE = "  vec4 sv_out = sv_shade(sv_hit, sv_rd);\n#ifdef SV_ANTIALIAS\n  if (!sv_is_hit) discard;\n#endif\n"
 _FS_DEPTH = """
   vec3 sv_ro; vec3 sv_rd; float sv_tmin;

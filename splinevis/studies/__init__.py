@@ -11,7 +11,7 @@ scheme is not available), is listed by :func:`notes`.
 Examples
 --------
 >>> sorted(STUDIES)
-['geometry-image', 'nurbs', 'terrain', 'volume', 'walkthrough']
+['antialiasing', 'geometry-image', 'nurbs', 'terrain', 'volume', 'walkthrough']
 >>> STUDIES["volume"].runner
 'splinevis.studies.volume:run_volume_study'
 """
@@ -86,6 +86,8 @@ STUDIES = {s.name: s for s in (
           "large NURBS models at interactive rates: levels of detail, culling, threads [Kumar1997]"),
     Study("geometry-image", "splinevis.studies.geometry_image:run_geometry_image_study",
           "smooth geometry images: GPU subdivision passes against the twin and against Loop/Catmull-Clark [Losasso2003]"),
+    Study("antialiasing", "splinevis.studies.antialiasing:run_antialiasing_study",
+          "reflection lines: plain step, filtered, supersampled and the users' mesh against a 4x4 reference"),
 )}
 
 
@@ -104,7 +106,7 @@ def get(name: str) -> Study:
     >>> get("sphere")
     Traceback (most recent call last):
     ...
-    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough', 'geometry-image'.
+    ValueError: study 'sphere' is not known; choose one of 'terrain', 'volume', 'nurbs', 'walkthrough', 'geometry-image', 'antialiasing'.
     """
     try:
         return STUDIES[name]

@@ -2,8 +2,8 @@
 // sv_highlight_spacing across it (direction W = m x E). A surface point p is lit when its normal line p + s n
 // meets a light; the band index is where that line pierces the plane, measured along W. Unlike reflection
 // lines they do not depend on the eye: the same surface gives the same bands from every view. Dark 0.15,
-// bright 1, filtered over the pixel with SV_ANTIALIAS (lib/effects/stripes.glsl).
-#include "lib/effects/stripes.glsl"
+// bright 1, filtered over the pixel with SV_ANTIALIAS (lib/effects/footprint.glsl).
+#include "lib/effects/footprint.glsl"
 uniform vec3 sv_highlight_plane;    // m, unit normal of the plane of lights (model frame)
 uniform vec3 sv_highlight_across;   // W, unit, in the plane, across the lights
 uniform float sv_highlight_height;  // h, the plane's offset along m (model frame)

@@ -1,6 +1,6 @@
 // Isophotes: curves of constant dot(n, L) for the first light, drawn as alternating bands (dark 0.2, bright 1),
-// filtered over the pixel with SV_ANTIALIAS (lib/effects/stripes.glsl).
-#include "lib/effects/stripes.glsl"
+// filtered over the pixel with SV_ANTIALIAS (lib/effects/footprint.glsl).
+#include "lib/effects/footprint.glsl"
 uniform float sv_isophote_bands;
 
 float sv_isophotes(vec3 n) {

@@ -3,9 +3,9 @@
 // orthonormal frame, sv_line_b and sv_line_c), so stripes of that angle show how the surface bends light; a
 // kink in the stripes is a kink in the normal field (G1 break), a kink in their curvature a curvature (G2)
 // break. With a = x (the default) b = y and c = z. Dark 0.15, bright 1, filtered over the pixel with
-// SV_ANTIALIAS (lib/effects/stripes.glsl): the angle's screen-space rate comes from the chain rule,
+// SV_ANTIALIAS (lib/effects/footprint.glsl): the angle's screen-space rate comes from the chain rule,
 // d atan(b, c) = (c db - b dc) / (b^2 + c^2), on the derivatives of r, so it has no jump where atan wraps.
-#include "lib/effects/stripes.glsl"
+#include "lib/effects/footprint.glsl"
 uniform float sv_stripes;  // number of dark/bright pairs over a half turn
 uniform vec3 sv_line_b;
 uniform vec3 sv_line_c;

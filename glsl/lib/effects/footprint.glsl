@@ -1,6 +1,7 @@
-// The light/dark step shared by reflection lines, isophotes and highlight lines, as a function of a smooth
+// Shading filtered over the pixel's footprint (Style.antialias): which quad neighbours' derivatives hold,
+// and the stripe filter. The light/dark step shared by reflection lines, isophotes and highlight lines, as a function of a smooth
 // stripe coordinate x: one dark/bright pair per unit, dark where fract(x) < 1/2 [the float64 twin:
-// splinevis.analysis.stripes.stripe_bright].
+// splinevis.analysis.footprint.stripe_bright].
 // With SV_ANTIALIAS the step is averaged over the pixel's footprint, a box of width w (in units of x) along x:
 // w = |dx/dX| + |dx/dY| from the screen-space derivatives (what fwidth gives), the support of the distribution
 // of a linear x over a square pixel. The average is the difference of the step's antiderivative
@@ -38,12 +39,12 @@ float sv_stripe_bright(float x, float w) {
 // coordinate, and its difference would be noise (grey dots along the proxy's edges). A nonzero derivative of
 // this flag marks that neighbour; the footprint is then taken from the other direction alone (twice it, the
 // same estimate for a square pixel), or, with no valid neighbour at all, no filtering.
-float sv_stripe_valid = 1.0;
+float sv_footprint_valid = 1.0;
 
 // Footprint width from the stripe coordinate's screen-space rates ax = |dx/dX| and ay = |dx/dY|.
 float sv_stripe_footprint(float ax, float ay) {
-    bool bad_x = dFdx(sv_stripe_valid) != 0.0;
-    bool bad_y = dFdy(sv_stripe_valid) != 0.0;
+    bool bad_x = dFdx(sv_footprint_valid) != 0.0;
+    bool bad_y = dFdy(sv_footprint_valid) != 0.0;
     if (bad_x && bad_y) return 0.0;
     if (bad_x) return 2.0 * ay;
     if (bad_y) return 2.0 * ax;

@@ -1,5 +1,6 @@
-"""The stripe step of reflection lines, isophotes and highlight lines, averaged over a pixel's footprint: the
-float64 twin of ``glsl/lib/effects/stripes.glsl``.
+"""Shading averaged over a pixel's footprint, the float64 twins of ``glsl/lib/effects/footprint.glsl`` (the
+stripes of reflection lines, isophotes and highlight lines) and of the filtered specular of
+``glsl/lib/effects/lights.glsl`` (:func:`toksvig_factor`).
 
 A stripe effect shades by a step function of a smooth stripe coordinate ``x`` (dark where ``fract(x) < 1/2``).
 One sample per pixel aliases it wherever a stripe is narrower than about two pixels (a moire on a teapot's
@@ -22,10 +23,11 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["stripe_bright", "stripe_width", "mean_deviation_bound", "float32_bound", "MIN_WIDTH", "MAX_WIDTH"]
+__all__ = ["stripe_bright", "stripe_width", "mean_deviation_bound", "float32_bound", "toksvig_factor", "MIN_WIDTH",
+           "MAX_WIDTH"]
 
 #: Footprints below this (stripe units) use the plain step; above :data:`MAX_WIDTH` (or not finite) the mean.
-#: The same constants as ``SV_STRIPE_MIN_WIDTH`` / ``SV_STRIPE_MAX_WIDTH`` in ``glsl/lib/effects/stripes.glsl``.
+#: The same constants as ``SV_STRIPE_MIN_WIDTH`` / ``SV_STRIPE_MAX_WIDTH`` in ``glsl/lib/effects/footprint.glsl``.
 MIN_WIDTH = 1.0 / 1024.0
 MAX_WIDTH = 1048576.0
 
@@ -94,3 +96,24 @@ def float32_bound(w) -> np.ndarray:
     True
     """
     return (4.0 / np.asarray(w, dtype=np.float64) + 8.0) * 2.0**-24
+
+
+def toksvig_factor(dn_dX, dn_dY, power) -> np.ndarray:
+    """Toksvig's factor ``ft = |Na| / (|Na| + s (1 - |Na|))`` [Toksvig2005, eq. 4-5] for unit normals whose
+    screen-space derivatives are ``dn_dX``, ``dn_dY`` (``(..., 3)``) and a Phong exponent ``s = power``: the
+    highlight's exponent becomes ``ft s``, its height is scaled by ``(1 + ft s) / (1 + s)``.
+
+    ``|Na|``, the length of the mean unit normal over the pixel, is ``1 - sigma^2 / 2`` to second order, with
+    ``sigma^2 = E|n - n0|^2 = (|dn/dX|^2 + |dn/dY|^2) / 12`` for a normal varying linearly over a unit box (the
+    variance of a uniform variable on ``[-1/2, 1/2]`` is 1/12).
+
+    >>> float(toksvig_factor([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], 40.0))   # a flat pixel: the highlight unchanged
+    1.0
+    >>> round(float(toksvig_factor([0.3, 0.0, 0.0], [0.0, 0.3, 0.0], 40.0)), 4)  # 0.3 rad a pixel: widened
+    0.7679
+    """
+    dx = np.asarray(dn_dX, dtype=np.float64)
+    dy = np.asarray(dn_dY, dtype=np.float64)
+    variance = (np.einsum("...i,...i", dx, dx) + np.einsum("...i,...i", dy, dy)) / 12.0
+    na = np.maximum(1.0 - variance / 2.0, 0.0)
+    return na / (na + power * (1.0 - na))
