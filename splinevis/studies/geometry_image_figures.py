@@ -44,7 +44,7 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 65, stripes: int = 12
     star-shaped: central projection would fold it)."""
     from datasets_synthetic.closed_meshes import bent_blob
 
-    from ..geometry_image.build import geometry_image_from_mesh
+    from ..geometry_image.build import FOLD_LEVEL, geometry_image_from_mesh
     from ..geometry_image.image import image_uv, octahedral_to_sphere, sphere_to_octahedral
     from ..geometry_image.program import surface_mesh
     from ..geometry_image.sphere import spherical_parametrization, surface_points
@@ -101,9 +101,12 @@ def pipeline_figure(path, *, quick: bool = False, n: int = 65, stripes: int = 12
         ax.set_title(title, fontsize=10)
         ax.set_xticks([])
         ax.set_yticks([])
-    fig.suptitle("Smooth geometry image of a bent blob [Losasso2003]: Hausdorff distance %.1e of the diagonal; "
-                 "%.1f%% of the limit triangles fold over where the parametrization undersamples the inner bend"
-                 % (report.distance["hausdorff"], 100 * report.folded), fontsize=11)
+    folds = report.folds or {}
+    fold_text = ("no limit triangle folds over" if folds.get("folded", 1) == 0 else
+                 "%.2g%% of the limit triangles fold over" % (100 * folds.get("fraction", report.folded)))
+    fig.suptitle("Smooth geometry image of a bent blob [Losasso2003]: Hausdorff distance %.1e of the diagonal; %s "
+                 "(level %d, the check's count; fairness %g)" % (report.distance["hausdorff"], fold_text,
+                                                                  FOLD_LEVEL, report.fairness), fontsize=11)
     return save_figure(fig, path, dpi=90)
 
 
