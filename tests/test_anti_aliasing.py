@@ -53,3 +53,12 @@ def test_bad_anti_aliasing_is_named():
         splinevis.Plotter(off_screen=True, window_size=WINDOW, anti_aliasing=True)
     with pytest.raises(ValueError, match="anti_aliasing='smaa' is not known"):
         splinevis.Plotter(off_screen=True, window_size=WINDOW, anti_aliasing="smaa")
+
+
+def test_vtk_ssaa_pass_draws_the_injected_programs():
+    # PyVista's "ssaa" (VTK's vtkSSAAPass) renders larger and filters down: our programs' fragments are drawn in
+    # it (the picture is not blank) and the outline gets partly covered pixels, as with anti_aliasing=k
+    plain, ss = _scene(), _scene(anti_aliasing="ssaa")
+    assert np.abs(ss - plain).mean() < 20  # the same picture ...
+    grey = (ss[..., 0] > 0) & (ss[..., 0] < 255) & (ss[..., 0] == ss[..., 2])
+    assert grey.sum() > 40  # ... with smoothed silhouettes
