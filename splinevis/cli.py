@@ -1,4 +1,5 @@
-"""The ``splinevis`` command: ``info``, ``selftest``, ``demo`` and ``study NAME`` (:data:`splinevis.studies.STUDIES`).
+"""The ``splinevis`` command: ``render FILE``, ``check``, ``info``, ``selftest``, ``demo``, ``study NAME``
+(:data:`splinevis.studies.STUDIES`) and ``--version``.
 
 Exit codes: 0 success, 1 the job ran and failed (selftest over its bounds), 2 bad usage, 3 no OpenGL.
 """
@@ -54,6 +55,23 @@ def _rows(rows):
     if isinstance(rows, dict):
         return [dict(v, function=k) if isinstance(v, dict) else {"function": k, "pass": bool(v)} for k, v in rows.items()]
     return list(rows)
+
+
+def _cmd_render(args) -> int:
+    from .render_file import render_file
+
+    try:
+        w, h = (int(v) for v in args.window.lower().split("x"))
+    except ValueError:
+        raise ValueError(f"--window {args.window!r} must be WIDTHxHEIGHT in pixels, e.g. --window 1024x768.") from None
+    r = render_file(args.file, args.output, effect=args.effect, isovalue=args.isovalue, window=(w, h),
+                    family=args.family, supersample=args.ssaa)
+    s = r["seconds"]
+    print(f"{r['out']}: {r['family']} {r['effect']}, {w} x {h} (read {s['read']:.2f} s, build {s['build']:.2f} s, "
+          f"draw {s['draw']:.2f} s)")
+    for note in r["notes"]:
+        print(f"  note: {note}")
+    return 0
 
 
 def _cmd_demo(args) -> int:
@@ -137,8 +155,22 @@ def main(argv=None) -> int:
     """
     from .studies import STUDIES
 
+    from . import __version__
+    from .render_file import EFFECT_STYLES
+
     parser = argparse.ArgumentParser(prog="splinevis", description="Exact per-pixel rendering of spline models.")
+    parser.add_argument("--version", action="version", version=f"splinevis {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("render", help="render a file (terrain, volume, CAD, closed mesh) exactly per pixel to a PNG")
+    p.add_argument("file", help="the file; its family is found from its content")
+    p.add_argument("-o", "--output", default=None, help="the PNG (default: FILE's name + .png, here)")
+    p.add_argument("--effect", choices=list(EFFECT_STYLES), default="shaded",
+                   help="shaded (two lights), zebra (reflection lines), isophotes or curvature (mean)")
+    p.add_argument("--isovalue", type=float, default=None, help="isosurface of a volume (default: from the histogram)")
+    p.add_argument("--window", default="1024x768", help="picture size WIDTHxHEIGHT (default 1024x768)")
+    p.add_argument("--family", choices=["auto", "terrain", "volume", "nurbs", "mesh"], default="auto")
+    p.add_argument("--ssaa", type=int, default=1, help="k: k x k samples a pixel (smooth silhouettes; default 1)")
+    p.set_defaults(func=_cmd_render)
     p = sub.add_parser("info", help="print the OpenGL vendor, renderer, version and VTK window class")
     p.add_argument("--backend", choices=["egl", "osmesa"], default=None, help="force a headless backend")
     p.set_defaults(func=_cmd_info)

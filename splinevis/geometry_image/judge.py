@@ -140,7 +140,7 @@ def _baseline(data: MeshData, model, options, findings):
 
 
 def _add(plotter, model, options):
-    return plotter.add_geometry_image(model, level=float(_option(options, "level")))
+    return plotter.add_geometry_image(model, level=float(_option(options, "level")), **options.get("style", {}))
 
 
 # ---------------------------------------------------------------------------------------------------- accuracy

@@ -243,7 +243,7 @@ def _build(data: NurbsFile, options, findings) -> NurbsModel:
 
 
 def _add(plotter, model, options):
-    return plotter.add_nurbs(model)
+    return plotter.add_nurbs(model, **options.get("style", {}))
 
 
 # ----------------------------------------------------------------------------------------------- baseline

@@ -183,7 +183,7 @@ def _accuracy(path, grid, model, baseline, options, findings):
 
 
 def _add(plotter, model, options):
-    return plotter.add_spline(model)
+    return plotter.add_spline(model, **options.get("style", {}))
 
 
 JUDGE = FamilyJudge("terrain", "warp_by_scalar mesh", _read, _build, _baseline, _accuracy, _add,

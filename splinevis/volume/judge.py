@@ -256,7 +256,7 @@ def _vtk_placement(path, pts):
 def _add(plotter, model, options):
     from ..programs import get
 
-    actor = plotter.add_spline(model)
+    actor = plotter.add_spline(model, **options.get("style", {}))
     program = get("isosurface")
     if program.on_add is not None:
         program.on_add(actor, plotter)
