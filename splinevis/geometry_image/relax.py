@@ -19,14 +19,22 @@ __all__ = ["DET_BOUND"]
 #: Cauchy-Schwarz), so a computed det above ``8 u`` is positive in exact arithmetic too.
 DET_BOUND = 8 * np.finfo(np.float64).eps / 2
 
+#: The relaxation factors its preconditioner anew every this many steps.
+REFACTOR = 4
+
+#: Steps before the relaxation may stop for slow progress (L-BFGS learns the curvature in its first steps).
+MIN_STEPS = 10
+
 
 def _unit(x):
     return x / np.linalg.norm(x, axis=-1, keepdims=True)
 
 
 def _det(X, F):
-    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-    return np.einsum("ij,ij->i", a, np.cross(b, c))
+    XT = np.ascontiguousarray(X.T)
+    a, b, c = XT[:, F[:, 0]], XT[:, F[:, 1]], XT[:, F[:, 2]]
+    return (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
 
 
 def _safe_step(X, d, lam, F, incident):
@@ -70,8 +78,10 @@ def _relax(X, S, iterations, progress, tol, memory=8):
         bar = tqdm(total=iterations, desc="stretch relaxation", unit="step")
     steps, history, energies = 0, [], [E]
     for _ in range(iterations):
-        if steps % 4 == 0:  # the preconditioner changes slowly: factor it every 4th step
-            lu = splu(S.preconditioner(sph))
+        if steps % REFACTOR == 0:  # the preconditioner changes slowly: factor it every REFACTOR-th step
+            # symmetric positive definite: a symmetric ordering and no pivoting (SuperLU's symmetric mode)
+            lu = splu(S.preconditioner(sph), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                      options={"SymmetricMode": True})
         # two-loop recursion
         q = g.copy()
         alphas = []
@@ -121,7 +131,7 @@ def _relax(X, S, iterations, progress, tol, memory=8):
         if sy > 1e-12 * np.vdot(s_k, s_k) ** 0.5 * np.vdot(y_k, y_k) ** 0.5:
             history = (history + [(s_k, y_k, 1.0 / sy)])[-memory:]
         X, g = Y, g_new
-        if len(energies) > 5 and energies[-6] - E < 5 * tol * E:  # under tol a step over the last 5 steps
+        if len(energies) > MIN_STEPS and energies[-6] - E < 5 * tol * E:  # under tol a step over the last 5 steps
             break
     if bar is not None:
         bar.close()

@@ -23,7 +23,7 @@ It is built in three stages, each of which keeps it one-to-one:
    measured on spherical triangle areas (:mod:`.stretch`), grows without bound as a spherical triangle
    degenerates, so descending it keeps the triangles apart. The descent is L-BFGS [Nocedal1980] on the tangent planes, the points put back on the sphere
    after each step, with :meth:`.stretch.StretchEnergy.preconditioner` as the initial inverse Hessian
-   (factored every 4th step). A step must lower the energy (Armijo); where it would flip a triangle it is
+   (factored every 4th step, by SuperLU in its symmetric mode). A step must lower the energy (Armijo); where it would flip a triangle it is
    halved for that triangle's vertices until none flips (:func:`_safe_step`).
 
 The result is checked, not assumed, to be one-to-one: every triangle must have ``det[a, b, c] > DET_BOUND``
@@ -121,7 +121,7 @@ def _spherical_area_sum(X, F):
 
 
 # --------------------------------------------------------------------------------------------- the pipeline
-def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200, tol: float = 1e-4,
+def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200, tol: float = 1e-3,
                               progress: bool = False, start: str = "auto") -> SphericalMap:
     """Map the closed genus-0 triangle mesh ``mesh`` (a ``pyvista.PolyData`` of outward triangles) one-to-one
     onto the unit sphere with low L2 stretch (module docstring); return a :class:`SphericalMap`.
@@ -136,8 +136,8 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     iterations : int
         Most steps of the stretch relaxation (0: the centered conformal start).
     tol : float
-        The relaxation stops once its last 5 steps lowered the energy by less than ``5 tol`` of it (or no step
-        lowers it).
+        The relaxation stops once its last 5 steps lowered the energy by less than ``5 tol`` of it (not before
+        its 10th step, while L-BFGS still learns the curvature), or when no step lowers it.
     progress : bool
         Show a tqdm progress bar over the relaxation's steps.
     start : {"auto", "tutte", "hierarchy"}

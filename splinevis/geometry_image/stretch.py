@@ -31,6 +31,16 @@ import numpy as np
 __all__ = ["StretchEnergy"]
 
 
+def _dot(u, v):
+    """Column-wise dot products of ``(3, N)`` rows."""
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+def _cross(u, v):
+    """Column-wise cross products of ``(3, N)`` rows (numpy's ``cross`` moves axes and copies)."""
+    return np.stack([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]])
+
+
 class StretchEnergy:
     """The L2 stretch of maps of the mesh ``(P, F)`` (``(V, 3)`` points, ``(F, 3)`` outward triangles) onto the
     unit sphere, as a function of the vertices' images ``X``: energy, gradient, preconditioner and report
@@ -65,23 +75,27 @@ class StretchEnergy:
         # corner gradients (F, 3) -> vertices
         self.gather = coo_matrix((np.ones(3 * len(F)), (F.ravel(), np.arange(3 * len(F)))),
                                  shape=(self.n, 3 * len(F))).tocsr()
+        # the same per component: rows (3, F) of coordinates, corner k of triangle t at k F + t
+        self._m = (self.M[:, 0, 0].copy(), self.M[:, 0, 1].copy(), self.M[:, 1, 1].copy())
+        self._corners = np.ascontiguousarray(F.T).ravel()
+        self._F = [np.ascontiguousarray(F[:, k]) for k in range(3)]
 
     def _terms(self, X):
-        """Per triangle: ``|J|_F^2`` of the flat triangle's map, its area, the spherical triangle's area, the
-        numerator and denominator of that area's half-angle tangent, the Gram matrix's inverse and edge vectors."""
-        F = self.F
-        a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-        DQ = np.stack([b - a, c - a], axis=2)
-        G = np.swapaxes(DQ, 1, 2) @ DQ
-        det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] ** 2
-        Ginv = np.empty_like(G)
-        Ginv[:, 0, 0], Ginv[:, 1, 1] = G[:, 1, 1] / det, G[:, 0, 0] / det
-        Ginv[:, 0, 1] = Ginv[:, 1, 0] = -G[:, 0, 1] / det
-        M = self.M
-        J2 = M[:, 0, 0] * Ginv[:, 0, 0] + 2.0 * M[:, 0, 1] * Ginv[:, 0, 1] + M[:, 1, 1] * Ginv[:, 1, 1]
-        num = np.einsum("ij,ij->i", a, np.cross(b, c))
-        den = 1.0 + np.einsum("ij,ij->i", a, b) + np.einsum("ij,ij->i", b, c) + np.einsum("ij,ij->i", c, a)
-        return J2, 0.5 * np.sqrt(np.maximum(det, 0.0)), 2.0 * np.arctan2(num, den), num, den, Ginv, DQ
+        """Per triangle, as rows ``(3, F)`` of coordinates: ``|J|_F^2`` of the flat triangle's map, its area, the
+        spherical triangle's area, the numerator and denominator of that area's half-angle tangent, the Gram
+        matrix's inverse ``(i00, i01, i11)`` and the corners and edge vectors ``(a, b, c, b - a, c - a)``."""
+        XT = np.ascontiguousarray(X.T)
+        a, b, c = XT[:, self._F[0]], XT[:, self._F[1]], XT[:, self._F[2]]
+        e1, e2 = b - a, c - a
+        g00, g01, g11 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+        det = g00 * g11 - g01 * g01
+        i00, i01, i11 = g11 / det, -g01 / det, g00 / det
+        m00, m01, m11 = self._m
+        J2 = m00 * i00 + 2.0 * m01 * i01 + m11 * i11
+        num = _dot(a, _cross(b, c))
+        den = 1.0 + _dot(a, b) + _dot(b, c) + _dot(c, a)
+        return (J2, 0.5 * np.sqrt(np.maximum(det, 0.0)), 2.0 * np.arctan2(num, den), num, den, (i00, i01, i11),
+                (a, b, c, e1, e2))
 
     def energy(self, X) -> float:
         """``E = sum_t area(P_t) |J_t|^2 / 2`` with ``J_t`` the flat triangle's map scaled to the spherical
@@ -113,21 +127,27 @@ class StretchEnergy:
         >>> bool(np.isclose(S.energy(X + dX) - S.energy(X - dX), 2 * np.vdot(g, dX), rtol=1e-5))
         True
         """
-        J2, flat, sph, num, den, Ginv, DQ = self._terms(X)
-        F = self.F
-        dD = -self.area[:, None, None] * (DQ @ (Ginv @ (self.M @ Ginv)))  # (F, 3, 2)
-        dJ = np.stack([-dD[:, :, 0] - dD[:, :, 1], dD[:, :, 0], dD[:, :, 1]], axis=1)  # (F, 3 corners, 3)
-        a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
-        n = np.cross(b - a, c - a)
-        n /= np.linalg.norm(n, axis=1, keepdims=True)
-        d_flat = 0.5 * np.stack([np.cross(n, c - b), np.cross(n, a - c), np.cross(n, b - a)], axis=1)
-        d_num = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
-        d_den = np.stack([b + c, c + a, a + b], axis=1)
-        d_sph = 2.0 * (den[:, None, None] * d_num - num[:, None, None] * d_den) / (num * num + den * den)[:, None, None]
+        J2, flat, sph, num, den, (i00, i01, i11), (a, b, c, e1, e2) = self._terms(X)
+        m00, m01, m11 = self._m
+        # A = G^-1 M G^-1 (symmetric), from T = M G^-1
+        t00, t01 = m00 * i00 + m01 * i01, m00 * i01 + m01 * i11
+        t10, t11 = m01 * i00 + m11 * i01, m01 * i01 + m11 * i11
+        A00, A01, A11 = i00 * t00 + i01 * t10, i00 * t01 + i01 * t11, i01 * t01 + i11 * t11
         e = 0.5 * self.area * J2  # the flat energy per triangle
         r = flat / sph
-        corner = dJ * r[:, None, None] + (e / sph)[:, None, None] * d_flat - (e * r / sph)[:, None, None] * d_sph
-        g = self.gather @ corner.reshape(-1, 3)
+        # corner k: r dJ_k + (e / sph) d_flat_k - (e r / sph) d_sph_k, d_sph_k = w (den d_num_k - num d_den_k)
+        dD0 = (-r * self.area) * (e1 * A00 + e2 * A01)
+        dD1 = (-r * self.area) * (e1 * A01 + e2 * A11)
+        n = _cross(e1, e2)
+        n *= (0.5 * e / sph) / np.sqrt(_dot(n, n))  # (e / sph) n / 2
+        beta = (2.0 * e * r / sph) / (num * num + den * den)
+        bd, bn = beta * den, beta * num
+        ca = -dD0 - dD1 + _cross(n, e2 - e1) - bd * _cross(b, c) + bn * (b + c)
+        cb = dD0 - _cross(n, e2) - bd * _cross(c, a) + bn * (c + a)
+        cc = dD1 + _cross(n, e1) - bd * _cross(a, b) + bn * (a + b)
+        g = np.empty((self.n, 3))
+        for j in range(3):
+            g[:, j] = np.bincount(self._corners, weights=np.concatenate([ca[j], cb[j], cc[j]]), minlength=self.n)
         return float(e @ r), g, sph
 
     def preconditioner(self, sph):
