@@ -438,6 +438,31 @@ class Plotter(pv.Plotter):
         return self.add_spline(model, style, program_options={"level": level, "displacement": displacement,
                                                               "backend": backend}, **options)
 
+    def add_walkthrough(self, model, pixel_error: float = 1.0, *, delta: float | None = None, levels: int = 4,
+                        threaded: bool = False, progress: bool = False, **options):
+        """Levels of detail of a large NURBS model drawn within ``pixel_error`` pixels of the surface [Kumar1997]:
+        returns the :class:`~splinevis.nurbs.lod.pipeline.Walkthrough`, whose ``fly(camera_path)`` renders a
+        camera path and ``interact()`` opens the window. ``model``: a NurbsModel (or surface), whose levels are
+        built with bounds ``delta * 4**l`` (default ``delta``: a thousandth of the model's size), or a ``LodModel``
+        already built; ``options`` go to the Walkthrough (``dynamic``, ``closeup``, ``color``, ...).
+
+        >>> from splinevis.nurbs.exact import torus
+        >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+        >>> walk = pl.add_walkthrough(torus(), levels=2)
+        >>> frames = walk.fly([[(0.0, -4.0, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]] * 2, progress=False)
+        >>> frames[-1]["triangles"] > 0
+        True
+        >>> pl.close()
+        """
+        from .nurbs.lod.bezier import bezier_set
+        from .nurbs.lod.levels import LodModel, build_lod
+        from .nurbs.lod.pipeline import Walkthrough
+
+        if not isinstance(model, LodModel):
+            step = 1e-3 * bezier_set(model).size if delta is None else float(delta)
+            model = build_lod(model, step, levels=levels, progress=progress)
+        return Walkthrough(model, self, threaded=threaded, pixel_error=pixel_error, **options)
+
     def render(self) -> None:
         """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`.
 

@@ -17,7 +17,9 @@ triangle mesh with one vertex per position. Each repair is reported, none is sil
   numbering;
 * **polygons** are triangulated, each into a fan whose diagonals are not edges of the mesh already (a fixed fan
   can make a closed quad mesh non-manifold: two quads sharing two sides, each cut along the same diagonal, make
-  one triangle twice); among the fans that qualify, the one with the shortest diagonals.
+  one triangle twice); among the fans that qualify, the one with the shortest diagonals;
+* **orientation**: a closed mesh whose faces are consistently turned inward (negative enclosed volume; VTK's
+  parametric surfaces come so) has every triangle turned over.
 
 Why our own code: pyvista's ``clean`` merges by a tolerance and ``triangulate`` cuts fixed fans; neither says
 what it changed, and a fixed fan breaks closed quad meshes (``beast.obj``).
@@ -161,6 +163,12 @@ def prepare_mesh(mesh, name: str = "mesh", weld_tolerance: float = WELD_TOLERANC
     >>> m, repairs = prepare_mesh(soup, "two triangles")
     >>> m.n_points, repairs[0][:42]
     (4, 'welded 6 points into 4 vertices (points at')
+
+    A closed mesh turned inside out is turned back:
+
+    >>> inside_out = pv.Sphere(theta_resolution=6, phi_resolution=6).flip_faces()
+    >>> prepare_mesh(inside_out, "sphere")[1][0][:34]
+    'turned all 48 triangles over: they'
     """
     import pyvista as pv
 
@@ -209,5 +217,22 @@ def prepare_mesh(mesh, name: str = "mesh", weld_tolerance: float = WELD_TOLERANC
         what = ", ".join(f"{count[k]:,} {_POLYGON_NAMES.get(k, f'{k}-gons')}" for k in sorted(count) if k != 3)
         repairs.append(f"triangulated {int((sizes != 3).sum()):,} polygons ({what}) into {len(tri):,} triangles in "
                        "all (fans whose diagonals are not edges already)")
+    if len(tri) and _closed(tri):
+        P = unique[tri]
+        volume = float(np.einsum("ij,ij->i", P[:, 0], np.cross(P[:, 1], P[:, 2])).sum() / 6.0)
+        if volume < 0:  # closed and consistently turned inward (VTK's parametric ellipsoid): turn every face
+            tri = tri[:, ::-1]
+            repairs.append(f"turned all {len(tri):,} triangles over: they faced inward (enclosed volume {volume:.6g})")
     faces = np.column_stack([np.full(len(tri), 3, dtype=np.int64), tri]).ravel()
     return pv.PolyData(unique, faces), repairs
+
+
+def _closed(tri) -> bool:
+    """Whether every edge of the triangles ``tri`` is used once in each direction (closed, consistently oriented),
+    the case where the sign of the enclosed volume says which way the faces point."""
+    e = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    fwd = np.unique(e, axis=0, return_counts=True)
+    if (fwd[1] != 1).any():
+        return False
+    rev = np.unique(e[:, ::-1], axis=0)
+    return fwd[0].shape == rev.shape and bool((fwd[0] == rev).all())
