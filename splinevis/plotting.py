@@ -8,19 +8,18 @@ from __future__ import annotations
 
 import os
 
-import difflib
-from dataclasses import fields
-
 import numpy as np
 
 from .effects import Style
 from .gl import headless
+from .plotting_options import READ_KEYWORDS, _anti_aliasing_choice, _check_window_size, _style_from
 
 headless.configure()
 
 import pyvista as pv  # noqa: E402  (after configure: VTK reads the window class at first window)
 
-from .gl.inject import SplineActor, capture_vtk_errors, raise_for_shader_errors  # noqa: E402
+from .gl.inject import SplineActor  # noqa: E402
+from .gl.vtk_errors import capture_vtk_errors, raise_for_shader_errors  # noqa: E402
 
 __all__ = ["Plotter", "companion_polydata"]
 
@@ -35,60 +34,6 @@ def companion_polydata(points, cells) -> pv.PolyData:
     cells = np.asarray(cells, dtype=np.int64)
     key = {3: "faces", 2: "lines", 1: "verts"}[cells.shape[1]]
     return pv.PolyData(np.asarray(points, dtype=np.float64), **{key: pv.CellArray.from_regular_cells(cells)})
-
-
-def _style_from(style, style_kwargs) -> Style:
-    names = {f.name for f in fields(Style)}
-    unknown = [k for k in style_kwargs if k not in names]
-    if unknown:
-        hints = []
-        for k in unknown:
-            close = difflib.get_close_matches(k, names, n=1)
-            hints.append(f"{k!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
-        raise TypeError(f"unknown effect or style option {', '.join(hints)}; known: {', '.join(sorted(names))}.")
-    if style is None:
-        return Style(**style_kwargs)
-    if not isinstance(style, Style):
-        raise TypeError(f"style must be a splinevis.Style, got {type(style).__name__}.")
-    return style.replace(**style_kwargs) if style_kwargs else style
-
-
-def _anti_aliasing_choice(value) -> tuple:
-    """``(kind for PyVista's enable_anti_aliasing or None, supersampling factor)`` of ``Plotter(anti_aliasing=)``.
-
-    >>> _anti_aliasing_choice(False), _anti_aliasing_choice(4), _anti_aliasing_choice("ssaa")
-    ((None, 1), (None, 4), ('ssaa', 1))
-    >>> _anti_aliasing_choice(True)
-    Traceback (most recent call last):
-    ValueError: anti_aliasing=True is ambiguous: give False, a supersampling factor k >= 2 (k x k samples a pixel, e.g. anti_aliasing=2), or one of PyVista's 'ssaa', 'fxaa', 'msaa'.
-    """
-    if value is None or value is False:
-        return None, 1
-    if isinstance(value, str) and value in ("ssaa", "fxaa", "msaa"):
-        return value, 1
-    if not isinstance(value, bool) and isinstance(value, (int, np.integer)) and 1 <= value <= 8:
-        return None, int(value)
-    raise ValueError(f"anti_aliasing={value!r} is " + ("ambiguous" if value is True else "not known") + ": give "
-                     "False, a supersampling factor k >= 2 (k x k samples a pixel, e.g. anti_aliasing=2), or one of "
-                     "PyVista's 'ssaa', 'fxaa', 'msaa'.")
-
-
-def _check_window_size(window_size) -> None:
-    """ValueError unless ``window_size`` is two positive ints ``(width, height)``.
-
-    >>> _check_window_size((0, 0))
-    Traceback (most recent call last):
-    ValueError: window_size=(0, 0) must be two positive pixel counts (width, height), e.g. window_size=(800, 600); a zero or negative size would silently render a 300 x 300 picture.
-    """
-    try:
-        w, h = window_size
-        ok = all(not isinstance(v, bool) and int(v) == v and int(v) > 0 for v in (w, h))
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise ValueError(f"window_size={window_size!r} must be two positive pixel counts (width, height), e.g. "
-                         "window_size=(800, 600); a zero or negative size would silently render a 300 x 300 "
-                         "picture.")
 
 
 class Plotter(pv.Plotter):
@@ -234,7 +179,9 @@ class Plotter(pv.Plotter):
         if program.kind in ("passes", "mesh"):  # the program made an ordinary dataset: a mesh with the effects
             from .gl.mesh_effects import add_mesh_with_effects
 
-            return add_mesh_with_effects(self, built, st, name=name)
+            actor = add_mesh_with_effects(self, built, st, name=name)
+            actor.model, actor.program = model, program
+            return actor
         spline = SplineActor(built, st, self.renderer, kind=program.kind)
         spline.model = model
         spline.program = program
@@ -383,7 +330,13 @@ class Plotter(pv.Plotter):
         from .programs import get
 
         program = get(program_name)
-        actor = self.add_spline(program.model_from(*args, **(read_options or {})), style, **options)
+        read_options = dict(read_options or {})
+        for key in READ_KEYWORDS:  # PyVista users pass an array's spacing and origin with it, as pv.wrap would
+            if key in options:
+                if key in read_options:
+                    raise TypeError(f"{key} given twice: as a keyword and in read_options.")
+                read_options[key] = options.pop(key)
+        actor = self.add_spline(program.model_from(*args, **read_options), style, **options)
         if program.on_add is not None:
             program.on_add(actor, self, **(add_options or {}))
         return actor

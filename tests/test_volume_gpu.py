@@ -70,7 +70,7 @@ def test_isovalue_outside_the_data_raises_with_the_range_in_add_isosurface_and_s
 
 
 def test_set_isovalue_replaces_textures_without_a_vtk_warning():
-    from splinevis.gl.inject import capture_vtk_errors
+    from splinevis.gl.vtk_errors import capture_vtk_errors
     from splinevis.volume.program import set_isovalue
 
     for program_options in (None, {"encoding": "coefficients"}):

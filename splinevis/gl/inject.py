@@ -21,15 +21,15 @@ measured on Mesa llvmpipe and are checked by tests/test_inject.py.
 
 from __future__ import annotations
 
-import re
 import numpy as np
 
 from ..effects import Style
-from ..errors import ShaderCompileError
-from .assembler import Assembled, assemble
+from .assembler import assemble
 from .spec import ProgramSpec
 from .textures import _colormap_image, _image_texture
+from .vtk_errors import capture_vtk_errors
 
+from pyvista import Actor as _PyVistaActor
 from vtkmodules.vtkCommonCore import VTK_OBJECT
 
 __all__ = ["ProgramSpec", "SplineActor", "make_actor", "camera_frame", "capture_vtk_errors"]
@@ -123,60 +123,6 @@ def _float_texture(array: np.ndarray, name: str):
     return to_vtk_texture(array, name=name)
 
 
-class capture_vtk_errors:
-    """Context manager collecting the text VTK sends to its output window (errors and warnings).
-
-    VTK reports a failed shader compile on its output window and carries on rendering; this is how we
-    turn that into a Python exception.
-
-    Examples
-    --------
-    >>> from vtkmodules.vtkCommonCore import vtkOutputWindow
-    >>> with capture_vtk_errors() as captured:
-    ...     vtkOutputWindow.GetInstance().DisplayErrorText("shader failed")
-    >>> captured.text
-    'shader failed\\n'
-    """
-
-    def __enter__(self):
-        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
-
-        self._window = vtkStringOutputWindow()
-        self._previous = vtkOutputWindow.GetInstance()
-        vtkOutputWindow.SetInstance(self._window)
-        return self
-
-    def __exit__(self, *exc):
-        from vtkmodules.vtkCommonCore import vtkOutputWindow
-
-        vtkOutputWindow.SetInstance(self._previous)
-        self.text = self._window.GetOutput() or ""
-        return False
-
-
-_NUMBERED = re.compile(r"^(\d+): ?(.*)$")
-
-
-def raise_for_shader_errors(text: str, assembled: Assembled | None = None) -> None:
-    """Raise :class:`ShaderCompileError` if ``text`` (VTK's output) reports a shader compile/link failure."""
-    if "vtkShaderProgram" not in text or not re.search(r"error", text, re.IGNORECASE):
-        return
-    source_lines, log_lines = [], []
-    for raw in text.splitlines():
-        body = raw.split("): ", 1)[1] if "vtkShaderProgram (" in raw and "): " in raw else raw
-        m = _NUMBERED.match(body)
-        if m and not re.match(r"^\d+:\d+\(\d+\)", body):
-            source_lines.append(m.group(2))
-        elif re.search(r"In vtk\w+\.cxx, line", body):
-            continue
-        elif re.search(r"\d+:\d+\(\d+\):|error|ERROR", body):
-            log_lines.append(body.strip())
-    source = "\n".join(source_lines)
-    stage = "fragment" if "fragOutput0" in source else ("vertex" if "gl_Position" in source else "unknown")
-    origin = assembled.origin_in(source) if assembled is not None and source else None
-    raise ShaderCompileError("\n".join(log_lines), source, stage, origin)
-
-
 def camera_frame(renderer, offset, position=None, rotation=None):
     """(eye, view direction, parallel flag, world-from-camera rotation) of ``renderer``'s camera in a model frame:
     world shifted by ``offset`` or, for a rotated model (``rotation`` R, placed at ``position``),
@@ -209,13 +155,16 @@ def camera_frame(renderer, offset, position=None, rotation=None):
     return eye, view, bool(cam.GetParallelProjection()), rot.T
 
 
-class SplineActor:
-    """A VTK actor ray-casting a spline program, and what it knows about its compiled program.
+class SplineActor(_PyVistaActor):
+    """A :class:`pyvista.Actor` ray-casting a spline program, and what it knows about its compiled program:
+    ``plotter.remove_actor``, ``visibility``, ``prop`` and the rest work as for any PyVista actor.
 
     Attributes
     ----------
-    actor : vtkActor
-        Add it to a renderer (``plotter.add_actor``) like any other actor.
+    actor : SplineActor
+        The VTK actor: this object itself (older code said ``spline_actor.actor``).
+    model, style
+        The model drawn (set by :meth:`splinevis.Plotter.add_spline`) and its :class:`~splinevis.Style`.
     assembled : Assembled
         The fragment block handed to VTK (inspect ``.text`` and ``.files``).
     program_sources : dict
@@ -241,7 +190,6 @@ class SplineActor:
                  kind: str = "raycast"):
         from vtkmodules.vtkCommonCore import vtkCommand
         from vtkmodules.vtkCommonDataModel import vtkPolyData
-        from vtkmodules.vtkRenderingCore import vtkActor
         from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
 
         self.spec = spec
@@ -278,13 +226,12 @@ class SplineActor:
         self.set_geometry(spec.points, spec.triangles, {**spec.attributes, **spec.varyings})
         self.mapper = mapper
 
-        actor = vtkActor()
-        actor.SetMapper(mapper)
+        super().__init__(mapper=mapper)  # a pyvista.Actor itself: remove_actor, visibility, ... as for meshes
+        actor = self
         self.offset = np.asarray(spec.offset, dtype=np.float64).reshape(3)
         actor.SetPosition(*self.offset.tolist())
-        self.actor = actor
         self.rotation = None  # world-from-model rotation (None: the identity; see set_frame)
-        self.position = self.offset
+        self.model_position = self.offset
         if spec.world_frame is not None:  # (rotation, pivot) of a rotated lattice
             self.set_frame(*spec.world_frame)
         prop = actor.GetProperty()
@@ -318,7 +265,6 @@ class SplineActor:
             self._textures["sv_environment_tex"] = _image_texture(np.asarray(style.environment), interpolate=True, repeat=True)
         for name, tex in self._textures.items():
             prop.SetTexture(name, tex)
-        self.actor = actor
         self.program_sources: dict = {}
         self.program_ids: set = set()
         self.extra_uniforms: dict = {}
@@ -326,6 +272,21 @@ class SplineActor:
         per_frame = spec.cull_per_frame is not None or spec.defines_per_frame is not None
         if per_frame and renderer is not None:  # before each frame: see ProgramSpec
             renderer.AddObserver(vtkCommand.StartEvent, self._on_render_start)
+
+    # attributes of ours are set after __init__ too (program, model): pyvista's guard against new ones is lifted
+    __setattr__ = object.__setattr__
+
+    @property
+    def actor(self):
+        """This actor: it is the VTK actor (older code said ``spline_actor.actor``).
+
+        >>> from splinevis.analytic import QuarticTrianglePatch
+        >>> from splinevis.analytic.program import patch_program
+        >>> a = SplineActor(patch_program(QuarticTrianglePatch.demo()), Style(lights=1))
+        >>> a.actor is a, isinstance(a, __import__("pyvista").Actor)
+        (True, True)
+        """
+        return self
 
     def _on_render_start(self, caller=None, event=None):
         """Per-frame face culling and build variant of specs that ask for them (``ProgramSpec.cull_per_frame``,
@@ -488,7 +449,7 @@ class SplineActor:
             raise ValueError(f"set_frame needs an orthonormal rotation, got {R.tolist()}.")
         pivot = np.asarray(pivot, dtype=np.float64).reshape(3)
         self.rotation = R
-        self.position = pivot + R @ (self.offset - pivot)
+        self.model_position = pivot + R @ (self.offset - pivot)
         shift = pivot - R @ pivot  # VTK applies the user matrix after the position (the offset)
         m = vtkMatrix4x4()
         for i in range(3):
@@ -498,7 +459,7 @@ class SplineActor:
         self.actor.SetUserMatrix(m)
         culler = getattr(self, "culler", None)  # a frustum culler attached before keeps up with the frame
         if culler is not None:
-            culler.offset, culler.rotation = self.position.copy(), R
+            culler.offset, culler.rotation = self.model_position.copy(), R
 
     def camera_frame(self):
         """(eye, view direction, parallel flag, world-from-camera rotation) of the renderer's camera.
@@ -520,7 +481,7 @@ class SplineActor:
                [0., 1., 0.],
                [0., 0., 1.]])
         """
-        return camera_frame(self.renderer, self.offset, self.position, self.rotation)
+        return camera_frame(self.renderer, self.offset, self.model_position, self.rotation)
 
     def _texture_map(self):
         """(scale_u, scale_v, shift_u, shift_v) from the model's parameter domain to the image."""
@@ -545,9 +506,9 @@ class SplineActor:
         if self.style.highlight_height is None:
             h_model = float((corners @ m_model).max() + np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
         else:
-            h_model = float(self.style.highlight_height - m @ self.position)
+            h_model = float(self.style.highlight_height - m @ self.model_position)
         return {"sv_highlight_plane": m_model, "sv_highlight_across": R.T @ across, "sv_highlight_height": h_model,
-                "sv_highlight_shift": float(across @ self.position)}
+                "sv_highlight_shift": float(across @ self.model_position)}
 
     def frame_uniforms(self) -> dict:
         """All uniforms for the next frame: camera, lights, spec, style and extras.

@@ -22,13 +22,14 @@ from __future__ import annotations
 
 
 import numpy as np
+import pyvista as pv
 from vtkmodules.vtkCommonCore import VTK_OBJECT
 
 from ..effects import EFFECTS, Style
 from .assembler import assemble
 from .inject import _set_uniform, camera_frame
 
-__all__ = ["add_mesh_with_reflection_lines", "add_mesh_with_effects", "MESH_EFFECTS", "CURVATURE_ARRAY"]
+__all__ = ["add_mesh_with_reflection_lines", "add_mesh_with_effects", "MeshActor", "MESH_EFFECTS", "CURVATURE_ARRAY"]
 
 #: Style effects a mesh made by a ``passes`` or ``mesh`` program can show.
 MESH_EFFECTS = frozenset({"lights", "reflection_lines", "isophotes", "antialias", "transparency", "curvature"})
@@ -71,6 +72,23 @@ _FS_EFFECT = {
     # an output mode replaces shading, unlit and opaque as in lib/core/shading.glsl
     "curvature": "    fragOutput0 = vec4(sv_curvature_color(svMeshCurvatureVS), 1.0);\n",
 }
+
+
+class MeshActor(pv.Actor):
+    """A ``pyvista.Actor`` drawing a mesh with a :class:`~splinevis.Style` (``.style``; ``.model`` and ``.program``
+    when a program made the mesh), so a mesh-drawing program's actor is used as the ray-cast ones are.
+
+    >>> from splinevis import Style
+    >>> from splinevis.plotting import Plotter
+    >>> pl = Plotter(off_screen=True, window_size=(32, 24))
+    >>> a = add_mesh_with_effects(pl, pv.Sphere(), Style(reflection_lines=4))
+    >>> isinstance(a, pv.Actor), a.style.reflection_lines, pl.remove_actor(a)
+    (True, 4, True)
+    >>> pl.close()
+    """
+
+    __setattr__ = object.__setattr__  # .style, .model, ... are set after construction
+    model = program = None
 
 
 def _replacements(effects) -> list[tuple[str, str, str]]:
@@ -134,7 +152,6 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
     ``program_sources`` hold the compiled vertex and fragment shaders after the first render."""
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkCommand
-    from vtkmodules.vtkRenderingCore import vtkActor
     from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
 
     effects = style.effect_set()
@@ -154,8 +171,8 @@ def _add_shaded_mesh(plotter, mesh, style: Style, name=None):
     if "curvature" in effects:
         _check_curvature(mesh)
         mapper.MapDataArrayToVertexAttribute("svMeshCurvature", CURVATURE_ARRAY, 0, -1)
-    actor = vtkActor()
-    actor.SetMapper(mapper)
+    actor = MeshActor(mapper=mapper)
+    actor.style = style
     actor.SetPosition(*centre)
     prop = actor.GetProperty()
     prop.SetColor(*style.color)
@@ -238,8 +255,8 @@ def add_mesh_with_effects(plotter, mesh, style, *, name=None):
     Effects a mesh cannot show yet (textures, environment maps, other output modes) raise a ``ValueError``
     naming them, instead of being dropped silently.
 
-    Returns the actor (with effects drawn by our shader code, a vtkActor whose ``program_sources`` hold the
-    compiled shaders after the first render).
+    Returns a :class:`MeshActor` (a ``pyvista.Actor``: ``remove_actor`` and the rest work) with ``.style``; with
+    effects drawn by our shader code its ``program_sources`` hold the compiled shaders after the first render.
 
     Examples
     --------
@@ -274,5 +291,10 @@ def add_mesh_with_effects(plotter, mesh, style, *, name=None):
                          f"{', '.join(sorted(MESH_EFFECTS))}. Remove them from the Style.")
     if effects & set(_SHADER_EFFECTS):
         return _add_shaded_mesh(plotter, mesh, style, name=name)
-    return plotter.add_mesh(mesh, color=style.color, smooth_shading=True, ambient=style.ambient,
-                            diffuse=style.diffuse, opacity=float(style.opacity), lighting=style.lights > 0, name=name)
+    plain = plotter.add_mesh(mesh, color=style.color, smooth_shading=True, ambient=style.ambient,
+                             diffuse=style.diffuse, opacity=float(style.opacity), lighting=style.lights > 0, name=name)
+    actor = MeshActor(mapper=plain.GetMapper(), prop=plain.GetProperty())  # the same drawing, with .style
+    actor.style, actor.program_sources = style, {}
+    plotter.remove_actor(plain, reset_camera=False)
+    plotter.add_actor(actor, reset_camera=True, name=name)
+    return actor

@@ -414,7 +414,7 @@ def attach_culling(actor, plotter, *, culling: bool = True) -> None:
 
     # a culling node must enclose every proxy box assigned to it: theta >= log2(block size)
     actor.culler = FrustumCuller(units, spacing=spacing, origin=-0.5 * spacing, grid_shape=model.spline.shape,
-                                 min_level=int(np.ceil(np.log2(B))), offset=actor.position, rotation=actor.rotation,
+                                 min_level=int(np.ceil(np.log2(B))), offset=actor.model_position, rotation=actor.rotation,
                                  on_change=show)
     actor.culler.attach(plotter.renderer)
 

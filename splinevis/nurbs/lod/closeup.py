@@ -465,7 +465,7 @@ class CloseUp:
                 for name, table in spec.textures.items():
                     spline.set_texture(name, table)
                 spline.spec = spec
-                spline.offset = spline.position = np.asarray(spec.offset, dtype=np.float64).reshape(3)
+                spline.offset = spline.model_position = np.asarray(spec.offset, dtype=np.float64).reshape(3)
                 spline.actor.SetPosition(*spline.offset.tolist())
             spline.model = model
             for other in self._actors.values():
