@@ -272,6 +272,7 @@ def _figure(path, pictures, rows):
         ax.set_title(name, fontsize=8)
         ax.tick_params(labelsize=6)
     axes[0, -1].legend(fontsize=5)
-    fig.suptitle("Reflection lines: close-ups against the 4x4-supersampled exact picture; error against frame time",
+    fig.suptitle("Reflection lines (and a real DEM, lit): close-ups against the 4x4-supersampled exact picture; "
+                 "error against frame time",
                  fontsize=10)
     save_figure(fig, path, dpi=100)
