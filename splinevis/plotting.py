@@ -36,6 +36,28 @@ def companion_polydata(points, cells) -> pv.PolyData:
     return pv.PolyData(np.asarray(points, dtype=np.float64), **{key: pv.CellArray.from_regular_cells(cells)})
 
 
+def _scalar_bar_mapper(style: Style, program_range):
+    """A mapper holding the colours ``style`` maps values to (its colormap over its ``scalar_range`` or the
+    program's, or the curvature output's blue-white-red over +-``curvature_scale``), for PyVista's
+    ``add_scalar_bar``; None when the style maps no value to a colour."""
+    if style.output == "curvature":
+        t = np.linspace(-1.0, 1.0, 256)[:, None]
+        blue, red, white = np.array([0.23, 0.30, 0.75]), np.array([0.71, 0.02, 0.15]), np.ones(3)
+        rgb = np.where(t < 0, white + (blue - white) * -t, white + (red - white) * t)  # glsl/lib/effects/curvature.glsl
+        lut = pv.LookupTable()
+        lut.values = np.column_stack([np.rint(255 * rgb), np.full(256, 255)]).astype(np.uint8)
+        lo, hi = -style.curvature_scale, style.curvature_scale
+    elif style.colormap is not None and style.output is None:
+        lut = pv.LookupTable(cmap=style.colormap, n_values=256)
+        lo, hi = style.scalar_range if style.scalar_range is not None else (program_range or (0.0, 1.0))
+    else:
+        return None
+    mapper = pv.DataSetMapper()
+    mapper.lookup_table = lut
+    mapper.scalar_range = (float(lo), float(hi))
+    return mapper
+
+
 class Plotter(pv.Plotter):
     """A :class:`pyvista.Plotter` with :meth:`add_spline`; everything else is PyVista's.
 
@@ -186,6 +208,9 @@ class Plotter(pv.Plotter):
         spline.model = model
         spline.program = program
         self.add_actor(spline.actor, name=name, reset_camera=True)
+        bar = _scalar_bar_mapper(st, built.uniforms.get("sv_scalar_range"))
+        if bar is not None:
+            self.mapper = bar  # add_scalar_bar() with no mapper shows this actor's colours, as after add_mesh
         self._spline_actors.append(spline)
         spline.companions = self._add_companions(model, st, name)
         return spline

@@ -59,3 +59,18 @@ def test_pyvista_keyword_names():
     with pytest.raises(TypeError, match="give cmap .* or colormap, not both"):
         _adders()["terrain"](pl, cmap="viridis", colormap="terrain")
     pl.close()
+
+
+def test_add_scalar_bar_shows_the_actors_colours():
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = _adders()["terrain"](pl, cmap="viridis")
+    bar = pl.add_scalar_bar("height")
+    lo, hi = actor.model.data_range  # the program's range: the heights of the data (the spline's overshoot aside)
+    assert np.allclose(bar.GetLookupTable().GetRange(), (lo, hi))
+    pl.close()
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    _adders()["nurbs"](pl, output="curvature", curvature_scale=2.0)
+    bar = pl.add_scalar_bar("mean curvature")
+    assert np.allclose(bar.GetLookupTable().GetRange(), (-2.0, 2.0))
+    assert np.asarray(pl.screenshot()).std() > 5
+    pl.close()
