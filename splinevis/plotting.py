@@ -441,6 +441,24 @@ class Plotter(pv.Plotter):
             model = build_lod(model, step, levels=levels, progress=progress)
         return Walkthrough(model, self, threaded=threaded, pixel_error=pixel_error, **options)
 
+    def show(self, *args, jupyter_backend=None, **kwargs):
+        """PyVista's :meth:`~pyvista.Plotter.show`. In Jupyter our programs render on the server: the ``static``
+        backend (a picture) and ``server`` (trame, rendered here, streamed) show them; ``client`` and ``html``
+        hand the scene to vtk.js in the browser, which knows nothing of our GLSL and would draw the proxies, so
+        they are refused (a spline-free scene may still use them: draw it with ``pyvista.Plotter``).
+
+        >>> pl = Plotter(off_screen=True, window_size=(32, 24))
+        >>> pl.show(jupyter_backend="client")
+        Traceback (most recent call last):
+        ValueError: jupyter_backend='client' renders in the browser with vtk.js, which drops splinevis's GLSL (the splines would show as their proxy boxes); use jupyter_backend='static' (a picture rendered here) or 'server' (trame, rendered here and streamed).
+        """
+        backend = jupyter_backend if jupyter_backend is not None else pv.global_theme.jupyter_backend
+        if isinstance(backend, str) and backend.lower() in ("client", "html"):
+            raise ValueError(f"jupyter_backend={backend!r} renders in the browser with vtk.js, which drops splinevis's "
+                             "GLSL (the splines would show as their proxy boxes); use jupyter_backend='static' (a "
+                             "picture rendered here) or 'server' (trame, rendered here and streamed).")
+        return super().show(*args, jupyter_backend=jupyter_backend, **kwargs)
+
     def render(self) -> None:
         """Render; a GLSL compile or link error raises :class:`splinevis.errors.ShaderCompileError`.
 
