@@ -175,7 +175,8 @@ def limit_mesh_arrays(image: GeometryImage, level: int):
 
 
 #: Image sizes ``n="auto"`` tries, smallest first, and the Hausdorff distance (share of the diagonal) that
-#: ends the search: the first size whose limit surface is that close to the mesh.
+#: ends the search: the first size whose limit surface is that close to the mesh. Sizes the rate of decrease
+#: measured so far predicts to stay above it are skipped (:func:`_next_size`).
 AUTO_SIZES = (33, 65, 129, 257)
 AUTO_HAUSDORFF = 0.005
 
@@ -188,6 +189,26 @@ AUTO_HAUSDORFF = 0.005
 #: at 1, 0.0018 % / 1.09 % at 3; nefertiti 0.017 % / 0.28 % at 0.1, 0.0064 % / 0.33 % at 0.3.
 AUTO_FAIRNESS = (0.1, 0.3, 1.0, 3.0)
 AUTO_FAIRNESS_HAUSDORFF = 0.01
+
+
+def _next_size(index: int, sizes, tried: dict) -> int:
+    """The index in ``sizes`` to try after ``sizes[index]``: the next one, or, once two sizes are measured, the
+    first the distances' rate of decrease so far predicts within :data:`AUTO_HAUSDORFF` (the last at most): a size
+    predicted to stay above the goal is not built (its sampling, fit and measurement would be spent to no use).
+
+    >>> _next_size(1, (33, 65, 129, 257), {33: 0.034, 65: 0.023})   # 0.68 a doubling: 257 still above, skip 129
+    3
+    >>> _next_size(1, (33, 65, 129, 257), {33: 0.012, 65: 0.006})   # halved: 129 predicted at 0.3 %
+    2
+    """
+    if index < 1 or len(tried) < 2:
+        return index + 1
+    h0, h1 = tried[sizes[index - 1]], tried[sizes[index]]
+    rate = h1 / h0 if h0 > 0 else 1.0
+    if not 0.0 < rate < 1.0:
+        return index + 1
+    steps = int(np.ceil(np.log(AUTO_HAUSDORFF / h1) / np.log(rate)))
+    return min(index + max(steps, 1), len(sizes) - 1) if index + 1 < len(sizes) else index + 1
 
 
 def _fold_measure(image, n: int) -> dict:
@@ -310,7 +331,9 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
     fairness = AUTO_FAIRNESS[0] if auto_fairness else float(fairness)
     measure = measure or len(sizes) > 1 or auto_fairness
     tried = {}
-    for n in sizes:
+    index = 0
+    while index < len(sizes):
+        n = sizes[index]
         t0 = time.perf_counter()
         M = int(oversample) * (int(n) - 1) + 1
         # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
@@ -331,6 +354,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
             tried[int(n)] = float(distance["hausdorff"])
             if distance["hausdorff"] <= AUTO_HAUSDORFF:
                 break
+        index = _next_size(index, sizes, tried)
     if len(sizes) > 1:
         distance["sizes_tried"] = tried
     folds = {}
@@ -349,11 +373,13 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
                 t0 = time.perf_counter()
                 P, N, F = limit_mesh_arrays(fit2.image, levels_finer)
                 distance2 = surface_distance(P, F, smap.points, smap.faces)
+                if distance2["hausdorff"] > AUTO_FAIRNESS_HAUSDORFF:  # smoothed too far from the mesh: keep the
+                    seconds["measure"] += time.perf_counter() - t0  # last fit that was close enough (its folds
+                    tried_f[stronger] = (float("nan"), float(distance2["hausdorff"]))  # are not counted: no use)
+                    break
                 folds2 = _fold_measure(fit2.image, n)
                 seconds["measure"] += time.perf_counter() - t0
                 tried_f[stronger] = (folds2["fraction"], float(distance2["hausdorff"]))
-                if distance2["hausdorff"] > AUTO_FAIRNESS_HAUSDORFF:
-                    break  # smoothed too far from the mesh: keep the last fit that was close enough
                 if folds2["folded"] < folds["folded"]:
                     fit, folds, fairness = fit2, folds2, stronger
                     distance = dict(distance2, **({"sizes_tried": tried} if len(sizes) > 1 else {}))
@@ -367,7 +393,8 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
                           f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
                           f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; "
                           + ("fairness tried (folds, distance): " + ", ".join(
-                              f"{f:g}: {100 * a:.2g}%, {100 * b:.2g}%" for f, (a, b) in folds["fairness_tried"].items())
+                              f"{f:g}: " + ("folds not counted" if a != a else f"{100 * a:.2g}%") + f", {100 * b:.2g}%"
+                              for f, (a, b) in folds["fairness_tried"].items())
                              + f"; kept {fairness:g} (a stronger one moves the surface more than "
                              f"{100 * AUTO_FAIRNESS_HAUSDORFF:g}% of the diagonal from the mesh)."
                              if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=2)
