@@ -86,7 +86,9 @@ def _finish(pl, camera, repeats):
 
 def _render_spline(model, window, camera, repeats):
     pl = _scene(window, camera)
-    pl.add_nurbs(model, lights=0, color=(1.0, 1.0, 1.0), reflection_lines=STRIPES, reflection_axis=AXIS)
+    # the plain step (antialias=False): the wrong-stripe count compares stripe positions with the twin's
+    pl.add_nurbs(model, lights=0, color=(1.0, 1.0, 1.0), reflection_lines=STRIPES, reflection_axis=AXIS,
+                 antialias=False)
     return _finish(pl, camera, repeats)
 
 
@@ -94,7 +96,8 @@ def _render_mesh(mesh, window, camera, repeats):
     from ..gl.mesh_effects import add_mesh_with_reflection_lines
 
     pl = _scene(window, camera)
-    add_mesh_with_reflection_lines(pl, mesh, STRIPES, color=(1.0, 1.0, 1.0), ambient=1.0, diffuse=0.0, axis=AXIS)
+    add_mesh_with_reflection_lines(pl, mesh, STRIPES, color=(1.0, 1.0, 1.0), ambient=1.0, diffuse=0.0, axis=AXIS,
+                                   antialias=False)
     return _finish(pl, camera, repeats)
 
 
