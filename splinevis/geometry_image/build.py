@@ -200,15 +200,18 @@ def _next_size(index: int, sizes, tried: dict) -> int:
     3
     >>> _next_size(1, (33, 65, 129, 257), {33: 0.012, 65: 0.006})   # halved: 129 predicted at 0.3 %
     2
+    >>> _next_size(3, (33, 65, 129, 257), {33: 0.034, 65: 0.023, 257: 0.0067})  # the last size measured: done
+    4
     """
-    if index < 1 or len(tried) < 2:
+    if index < 1 or len(tried) < 2 or index + 1 >= len(sizes):
         return index + 1
-    h0, h1 = tried[sizes[index - 1]], tried[sizes[index]]
-    rate = h1 / h0 if h0 > 0 else 1.0
+    before, last = list(tried)[-2:]  # the last two measured: a rate per step of the list
+    h0, h1 = tried[before], tried[last]
+    rate = (h1 / h0) ** (1.0 / max(sizes.index(last) - sizes.index(before), 1)) if h0 > 0 else 1.0
     if not 0.0 < rate < 1.0:
         return index + 1
     steps = int(np.ceil(np.log(AUTO_HAUSDORFF / h1) / np.log(rate)))
-    return min(index + max(steps, 1), len(sizes) - 1) if index + 1 < len(sizes) else index + 1
+    return min(index + max(steps, 1), len(sizes) - 1)
 
 
 def _fold_measure(image, n: int) -> dict:
