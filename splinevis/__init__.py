@@ -9,6 +9,10 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
+from ._optional import install as _install_extras_finder
+
+_install_extras_finder()  # a missing optional module names the extra that brings it
+
 from .effects import Style as Style
 from .errors import (
     OpenGLUnavailableError as OpenGLUnavailableError,

@@ -39,7 +39,7 @@ setup_python() {
     if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
         echo "[splinevis] installing splinevis (editable) and its pinned dependencies into .venv"
         .venv/bin/python -m pip install -q --upgrade pip
-        .venv/bin/python -m pip install -q -c requirements/pinned.txt -e ".[test,cad]"
+        .venv/bin/python -m pip install -q -c requirements/pinned.txt -e ".[test,all]"
         echo "$want" > "$stamp"
     fi
 }
