@@ -34,7 +34,7 @@ def test_missing_libraries_give_install_command(monkeypatch):
 
 
 def test_unknown_backend_is_named():
-    with pytest.raises(ValueError, match="'vulkan' is not known; choose 'egl' or 'osmesa'"):
+    with pytest.raises(ValueError, match="'vulkan' is not known; choose 'egl', 'osmesa' or 'x'"):
         headless.configure("vulkan")
 
 

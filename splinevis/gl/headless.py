@@ -23,9 +23,10 @@ INSTALL_HINT = (
     "(or run `make setup` in the splinevis repository)"
 )
 
-_WINDOW_CLASS = {"egl": "vtkEGLRenderWindow", "osmesa": "vtkOSOpenGLRenderWindow"}
-# Shared objects each backend needs to be loadable (the Mesa EGL vendor library or OSMesa itself).
-_LIBRARIES = {"egl": ("libEGL.so.1", "libEGL_mesa.so.0", "libGL.so.1"), "osmesa": ("libOSMesa.so.8",)}
+_WINDOW_CLASS = {"egl": "vtkEGLRenderWindow", "osmesa": "vtkOSOpenGLRenderWindow", "x": "vtkXOpenGLRenderWindow"}
+# Shared objects each backend needs to be loadable (the Mesa EGL vendor library or OSMesa itself; GLX and X11).
+_LIBRARIES = {"egl": ("libEGL.so.1", "libEGL_mesa.so.0", "libGL.so.1"), "osmesa": ("libOSMesa.so.8",),
+              "x": ("libGL.so.1", "libX11.so.6")}
 
 
 def _loadable(name: str) -> bool:
@@ -43,17 +44,36 @@ def backend_libraries() -> dict:
     --------
     >>> libs = backend_libraries()
     >>> sorted(libs), list(libs["osmesa"])
-    (['egl', 'osmesa'], ['libOSMesa.so.8'])
+    (['egl', 'osmesa', 'x'], ['libOSMesa.so.8'])
     """
     return {b: {lib: _loadable(lib) for lib in libs} for b, libs in _LIBRARIES.items()}
+
+
+def _display_opens() -> bool:
+    """Whether ``DISPLAY`` is set and an X server accepts a connection there (Xlib's ``XOpenDisplay``)."""
+    if not os.environ.get("DISPLAY") or not all(backend_libraries()["x"].values()):
+        return False
+    try:
+        x11 = ctypes.CDLL("libX11.so.6")
+        x11.XOpenDisplay.restype = ctypes.c_void_p
+        x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+        display = x11.XOpenDisplay(None)
+        if not display:
+            return False
+        x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+        x11.XCloseDisplay(display)
+        return True
+    except OSError:
+        return False
 
 
 def configure(backend: str | None = None) -> str:
     """Select the headless window class for VTK and return the backend name (``"egl"`` or ``"osmesa"``).
 
     Order of precedence: the ``backend`` argument, the environment variable ``SPLINEVIS_GL``, an already
-    set ``VTK_DEFAULT_OPENGL_WINDOW`` (respected as the user's choice), then EGL if its libraries load,
-    then OSMesa. Must run before VTK creates its first render window; :mod:`splinevis.plotting` calls it
+    set ``VTK_DEFAULT_OPENGL_WINDOW`` (respected as the user's choice), then ``"x"`` (VTK's X window, so
+    ``show()`` opens a window the user can turn with the mouse) when ``DISPLAY`` names an X server that accepts
+    a connection, then EGL if its libraries load, then OSMesa. Must run before VTK creates its first render window; :mod:`splinevis.plotting` calls it
     on import.
 
     Raises
@@ -65,11 +85,11 @@ def configure(backend: str | None = None) -> str:
 
     Examples
     --------
-    >>> configure() in ("egl", "osmesa")  # keeps the choice already made (splinevis.plotting made one)
+    >>> configure() in ("egl", "osmesa", "x")  # keeps the choice already made (splinevis.plotting made one)
     True
     >>> configure("directx")
     Traceback (most recent call last):
-    ValueError: OpenGL backend 'directx' is not known; choose 'egl' or 'osmesa' (SPLINEVIS_GL).
+    ValueError: OpenGL backend 'directx' is not known; choose 'egl', 'osmesa' or 'x' (SPLINEVIS_GL).
     """
     requested = backend or os.environ.get("SPLINEVIS_GL") or None
     if requested is None and os.environ.get("VTK_DEFAULT_OPENGL_WINDOW") in _WINDOW_CLASS.values():
@@ -78,10 +98,10 @@ def configure(backend: str | None = None) -> str:
     if requested is not None:
         requested = requested.lower()
         if requested not in _WINDOW_CLASS:
-            raise ValueError(f"OpenGL backend {requested!r} is not known; choose 'egl' or 'osmesa' (SPLINEVIS_GL).")
+            raise ValueError(f"OpenGL backend {requested!r} is not known; choose 'egl', 'osmesa' or 'x' (SPLINEVIS_GL).")
         candidates = [requested]
     else:
-        candidates = ["egl", "osmesa"]
+        candidates = (["x"] if _display_opens() else []) + ["egl", "osmesa"]
     for name in candidates:
         if all(libs[name].values()):
             os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = _WINDOW_CLASS[name]
