@@ -172,7 +172,7 @@ def main(argv=None) -> int:
     p.add_argument("--ssaa", type=int, default=1, help="k: k x k samples a pixel (smooth silhouettes; default 1)")
     p.set_defaults(func=_cmd_render)
     p = sub.add_parser("info", help="print the OpenGL vendor, renderer, version and VTK window class")
-    p.add_argument("--backend", choices=["egl", "osmesa"], default=None, help="force a headless backend")
+    p.add_argument("--backend", choices=["egl", "osmesa", "x"], default=None, help="force an OpenGL backend")
     p.set_defaults(func=_cmd_info)
     p = sub.add_parser("selftest", help="run the GLSL-vs-float64 numeric harness")
     p.add_argument("--out", required=True, help="directory for selftest.json")
