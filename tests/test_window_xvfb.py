@@ -18,9 +18,14 @@ pytestmark = pytest.mark.gl
 def test_window_opens_draws_turns_and_closes_under_xvfb():
     script = Path(__file__).with_name("_window_xvfb.py")
     env = {k: v for k, v in os.environ.items() if k not in ("SPLINEVIS_GL", "VTK_DEFAULT_OPENGL_WINDOW", "DISPLAY")}
-    run = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 800x600x24", sys.executable, str(script)],
-                         capture_output=True, text=True, timeout=300, env=env)
-    assert run.returncode == 0, run.stderr[-2000:]
+    runs = []
+    for _ in range(2):  # one retry: seen once in ~20 runs on a loaded machine, VTK could not make its first GLX
+        run = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 800x600x24", sys.executable, str(script)],
+                             capture_output=True, text=True, timeout=300, env=env)  # window on a fresh Xvfb
+        runs.append(run)
+        if run.returncode == 0 and '"vtkXOpenGLRenderWindow"' in run.stdout:
+            break
+    assert run.returncode == 0, "\n---\n".join(r.stderr[-1500:] for r in runs)
     out = json.loads(run.stdout.strip().splitlines()[-1])
     assert out["window_class"] == "vtkXOpenGLRenderWindow" and not out["off_screen"]  # a real window
     assert out["drawn_fraction"] > 0.2          # the spline is drawn in it
