@@ -25,7 +25,7 @@ from .measure import surface_distance
 from .model import GeometryImage
 
 __all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "fold_counts",
-           "FOLDED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF"]
+           "FOLDED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF", "auto_oversample"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,6 +191,21 @@ AUTO_FAIRNESS = (0.1, 0.3, 1.0, 3.0)
 AUTO_FAIRNESS_HAUSDORFF = 0.01
 
 
+def auto_oversample(n: int, vertices: int) -> int:
+    """Samples per control interval for an ``n x n`` image of a mesh of ``vertices`` vertices: at least 2 (two
+    samples per control interval, what the least-squares fit needs to see each cubic span's shape), and enough
+    that the ``M x M`` sample grid (``M = k (n - 1) + 1``) holds about 4 samples per mesh vertex (``M >= 2
+    sqrt(V)``), at most 4. Measured on the beast scan (32k vertices) at ``n = 257``: 2 instead of 4 samples
+    263k directions instead of 1.05M (9 s instead of 43 s) and gives the same Hausdorff distance (0.898 %) and
+    folds within 5 % (0.079 % against 0.076 %).
+
+    >>> auto_oversample(257, 32311), auto_oversample(129, 32311), auto_oversample(33, 5000)
+    (2, 3, 4)
+    """
+    need = int(np.ceil(2.0 * np.sqrt(max(int(vertices), 1)) / max(int(n) - 1, 1)))
+    return int(min(max(need, 2), 4))
+
+
 def _next_size(index: int, sizes, tried: dict) -> int:
     """The index in ``sizes`` to try after ``sizes[index]``: the next one, or, once two sizes are measured, the
     first the distances' rate of decrease so far predicts within :data:`AUTO_HAUSDORFF` (the last at most): a size
@@ -226,7 +241,7 @@ def _fold_measure(image, n: int) -> dict:
             "at_cut": at_cut}
 
 
-def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int = 4,
+def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="auto",
                              name: str = "mesh", measure: bool = True, levels_finer: int = 2, progress: bool = False,
                              parametrization_options: dict | None = None, orientation="auto", sphere_map=None):
     """Build an ``n x n`` smooth geometry image of the closed genus-0 ``mesh`` (module docstring).
@@ -246,8 +261,9 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
         (default): 0.1 (sizes are chosen with it), then the next of :data:`AUTO_FAIRNESS` while the image folds,
         as long as the surface stays within :data:`AUTO_FAIRNESS_HAUSDORFF` of the mesh; the fit with the fewest
         folds is kept (``folds["fairness_tried"]`` lists each weight's fold fraction and distance).
-    oversample : int
-        Mesh samples per control point and direction.
+    oversample : int or "auto"
+        Mesh samples per control point and direction; ``"auto"`` (:func:`auto_oversample`) as few as resolve
+        both the image and the mesh.
     name : str
         How errors and the report call the mesh.
     measure : bool
@@ -338,13 +354,14 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
     while index < len(sizes):
         n = sizes[index]
         t0 = time.perf_counter()
-        M = int(oversample) * (int(n) - 1) + 1
+        k = auto_oversample(n, info["vertices"]) if isinstance(oversample, str) and oversample == "auto" else oversample
+        M = int(k) * (int(n) - 1) + 1
         # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
         samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R).reshape(M, M, 3)
         seconds["sample"] = seconds.get("sample", 0.0) + time.perf_counter() - t0
 
         t0 = time.perf_counter()
-        fit = fit_geometry_image(None, n, fairness=fairness, oversample=oversample, samples=samples)
+        fit = fit_geometry_image(None, n, fairness=fairness, oversample=k, samples=samples)
         seconds["fit"] = seconds.get("fit", 0.0) + time.perf_counter() - t0
 
         distance, folded = {}, float("nan")
@@ -371,7 +388,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample: int
                 if folds["fraction"] <= FOLDED_WARNING:
                     break
                 t0 = time.perf_counter()
-                fit2 = fit_geometry_image(None, n, fairness=stronger, oversample=oversample, samples=samples)
+                fit2 = fit_geometry_image(None, n, fairness=stronger, oversample=k, samples=samples)
                 seconds["fit"] += time.perf_counter() - t0
                 t0 = time.perf_counter()
                 P, N, F = limit_mesh_arrays(fit2.image, levels_finer)
