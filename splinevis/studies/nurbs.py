@@ -84,20 +84,20 @@ def _finish(pl, camera, repeats):
     return img, matrix, row
 
 
-def _render_spline(model, window, camera, repeats):
+def _render_spline(model, window, camera, repeats, antialias=False):
     pl = _scene(window, camera)
-    # the plain step (antialias=False): the wrong-stripe count compares stripe positions with the twin's
+    # the plain step by default (antialias=False): the wrong-stripe count compares stripe positions with the twin's
     pl.add_nurbs(model, lights=0, color=(1.0, 1.0, 1.0), reflection_lines=STRIPES, reflection_axis=AXIS,
-                 antialias=False)
+                 antialias=antialias)
     return _finish(pl, camera, repeats)
 
 
-def _render_mesh(mesh, window, camera, repeats):
+def _render_mesh(mesh, window, camera, repeats, antialias=False):
     from ..gl.mesh_effects import add_mesh_with_reflection_lines
 
     pl = _scene(window, camera)
     add_mesh_with_reflection_lines(pl, mesh, STRIPES, color=(1.0, 1.0, 1.0), ambient=1.0, diffuse=0.0, axis=AXIS,
-                                   antialias=False)
+                                   antialias=antialias)
     return _finish(pl, camera, repeats)
 
 
@@ -221,13 +221,14 @@ def _figures(out, pareto, scaling):
 
 
 def side_by_side(out, model, window, mesh_density=2):
-    """Zebra stripes of a coarse mesh (interpolated normals) beside the per-fragment program's."""
+    """Zebra stripes of a coarse mesh (interpolated normals) beside the per-fragment program's, as users see them
+    (the stripes filtered over the pixel, the default)."""
     from PIL import Image
 
     from ..nurbs.tessellate import tessellate
 
-    a, _, _ = _render_mesh(tessellate(model, mesh_density), window, PARETO_CAMERA, 1)
-    b, _, _ = _render_spline(model, window, PARETO_CAMERA, 1)
+    a, _, _ = _render_mesh(tessellate(model, mesh_density), window, PARETO_CAMERA, 1, antialias=True)
+    b, _, _ = _render_spline(model, window, PARETO_CAMERA, 1, antialias=True)
     img = np.concatenate([a, np.ones((a.shape[0], 6, 3)), b], axis=1)
     Image.fromarray((img * 255).astype(np.uint8)).save(out / "zebra_side_by_side.png")
 
