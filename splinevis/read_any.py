@@ -6,7 +6,31 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["read"]
+__all__ = ["read", "family_of"]
+
+
+def family_of(path, family: str = "auto") -> str:
+    """The family of the file ``path`` (``family`` itself unless ``"auto"``): FileNotFoundError for a missing
+    file, ValueError naming the reason for one splinevis does not read.
+
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "tiny.asc").write_text("ncols 3\\nnrows 2\\nxllcorner 0\\nyllcorner 0\\ncellsize 10\\n1 2 3\\n4 5 6\\n")
+    >>> family_of(d / "tiny.asc")
+    'terrain'
+    """
+    from .check.detect import FAMILIES, detect_family
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file.")
+    if family != "auto":
+        return family
+    found, why = detect_family(path)
+    if found is None:
+        raise ValueError(f"{path}: not a file splinevis reads ({why}); pass family= (--family) if it is one of "
+                         f"{', '.join(FAMILIES)}.")
+    return found
 
 
 def read(path, *, family: str = "auto", **options):
@@ -33,16 +57,10 @@ def read(path, *, family: str = "auto", **options):
     >>> type(grid).__name__, grid.shape
     ('HeightGrid', (2, 3))
     """
-    from .check.detect import FAMILIES, detect_family
+    from .check.detect import FAMILIES
 
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file.")
-    if family == "auto":
-        family, why = detect_family(path)
-        if family is None:
-            raise ValueError(f"{path}: not a file splinevis reads ({why}); pass family= if it is one of "
-                             f"{', '.join(FAMILIES)}.")
+    family = family_of(path, family)
     if family == "terrain":
         from .io import read_heights
 

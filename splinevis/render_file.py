@@ -64,20 +64,14 @@ def render_file(path, out=None, *, effect: str = "shaded", isovalue: float | Non
     """
     import numpy as np
 
-    from .check.detect import FAMILIES, detect_family
     from .check.run import get_judge
+    from .read_any import family_of
     from .plotting import Plotter
 
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file.")
     if effect not in EFFECT_STYLES:
         raise ValueError(f"effect {effect!r} is not known; choose one of {', '.join(EFFECT_STYLES)}.")
-    if family == "auto":
-        family, why = detect_family(path)
-        if family is None:
-            raise ValueError(f"{path}: not a file splinevis draws ({why}); give --family if it is one of "
-                             f"{', '.join(FAMILIES)}.")
+    family = family_of(path, family)
     judge = get_judge(family)
     options = {} if isovalue is None else {"isovalue": float(isovalue)}
     seconds, findings = {}, []

@@ -48,4 +48,4 @@ def test_render_errors_are_named(tmp_path, capsys):
     notes = tmp_path / "notes.txt"
     notes.write_text("hello")
     assert cli.main(["render", str(notes)]) == 2
-    assert "not a file splinevis draws" in capsys.readouterr().err
+    assert "not a file splinevis reads" in capsys.readouterr().err
