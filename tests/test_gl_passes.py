@@ -106,11 +106,16 @@ def _vtk_window_round_trip():
 def test_texture_kept_on_the_gpu_across_vtk_rendering_is_refused_not_misread():
     x = np.full((2, 3), 5.0)
     tex = run_passes([Pass(ADD_ONE, {"sv_src": "x"}, "y")], {"x": x}, readback=False)
-    _vtk_window_round_trip()  # replaces our context (VTK terminates the EGL display it shares with us)
-    with pytest.raises(ValueError, match="context that no longer exists"):
-        run_passes([Pass(COPY, {"sv_src": "t"})], {"t": tex})
-    with pytest.raises(ValueError, match="context that no longer exists"):
-        read_rgba32f(tex)
+    _vtk_window_round_trip()  # replaces our context when VTK terminates the EGL display it shares with us
+    # Refused, or (where the process's earlier windows left our context alive: the order the test workers ran
+    # their tests in decides it) read right: never misread.
+    for use in (lambda: run_passes([Pass(COPY, {"sv_src": "t"})], {"t": tex}), lambda: read_rgba32f(tex)):
+        try:
+            got = use()
+        except ValueError as exc:
+            assert "context that no longer exists" in str(exc)
+        else:
+            assert np.all(np.asarray(got)[:, :, 0] == 6.0)
     assert np.all(run_passes([Pass(ADD_ONE, {"sv_src": "x"})], {"x": x})[:, :, 0] == 6.0)
 
 
