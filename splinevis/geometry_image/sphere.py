@@ -121,7 +121,7 @@ def _spherical_area_sum(X, F):
 
 
 # --------------------------------------------------------------------------------------------- the pipeline
-def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200, tol: float = 1e-3,
+def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200, tol: float = 1e-4,
                               progress: bool = False, start: str = "auto") -> SphericalMap:
     """Map the closed genus-0 triangle mesh ``mesh`` (a ``pyvista.PolyData`` of outward triangles) one-to-one
     onto the unit sphere with low L2 stretch (module docstring); return a :class:`SphericalMap`.
@@ -137,7 +137,10 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
         Most steps of the stretch relaxation (0: the centered conformal start).
     tol : float
         The relaxation stops once its last 5 steps lowered the energy by less than ``5 tol`` of it (not before
-        its 10th step, while L-BFGS still learns the curvature), or when no step lowers it.
+        its 10th step, while L-BFGS still learns the curvature), or when no step lowers it. ``1e-3`` is about
+        twice as fast on the 100k-triangle scans but leaves local distortion the geometry image's fit turns into
+        ripples: nefertiti folded on 0.18 % of its level-4 limit triangles at fairness 0.1 against 0.048 % at
+        ``1e-4`` (0.046 % and 0.0086 % at fairness 3).
     progress : bool
         Show a tqdm progress bar over the relaxation's steps.
     start : {"auto", "tutte", "hierarchy"}
