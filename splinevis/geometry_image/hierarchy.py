@@ -217,10 +217,11 @@ def _insert(X, removed, target, T, owner):
     second = T[:, 2] == u
     y[owner[second]] = T[second, 1]
     Xu = X[target]
-    tx, ty = _unit(X[x] - Xu), _unit(X[y] - Xu)
     ring_sum = np.zeros((removed.size, 3))
     np.add.at(ring_sum, owner, X[T[:, 1]])
-    directions = [_unit(tx + ty), -_unit(tx + ty), _unit(ring_sum) - Xu]
+    with np.errstate(invalid="ignore", divide="ignore"):  # opposite tx, ty: a direction of NaN, tried as 0 below
+        tx, ty = _unit(X[x] - Xu), _unit(X[y] - Xu)
+        directions = [_unit(tx + ty), -_unit(tx + ty), _unit(ring_sum) - Xu]
     placed = np.zeros(removed.size, dtype=bool)
     for d in directions:
         for s in 0.5 ** np.arange(1, 52):
