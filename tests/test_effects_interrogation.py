@@ -16,39 +16,16 @@ import pytest
 import splinevis
 from splinevis.analysis.zebra import zebra_reference
 from splinevis.gl.camera import pixel_rays
-from splinevis.io import VolumeGrid
 from splinevis.programs import program_for
-from splinevis.volume.isosurface import Isosurface
-from splinevis.volume.model import VolumeSpline
+from _sphere_scene import CAMERA, WINDOW, render, sphere
 
 pytestmark = pytest.mark.gl
 
-N = 40
-WINDOW = (160, 120)
-CAMERA = [(2.6, -1.9, 1.7), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
 # float32 normals of the sphere spline are good to ~1e-4 rad against its float64 twin; a pixel's ray and the
 # twin's ray through the pixel centre agree; the spline itself is only an approximation of the sphere, but both
 # sides see the same spline. Margins below are a few times that.
 ANGLE_MARGIN = 3e-3
-
-
-def _sphere():
-    x = np.linspace(-1, 1, N)
-    z, y, xx = np.meshgrid(x, x, x, indexing="ij")
-    grid = VolumeGrid(np.sqrt(xx**2 + y**2 + z**2), spacing=(2 / (N - 1),) * 3, origin=(-1, -1, -1))
-    return Isosurface(VolumeSpline(grid), 0.7)
-
-
-def _render(model, **style):
-    pl = splinevis.Plotter(off_screen=True, window_size=WINDOW)
-    pl.set_background("black")
-    pl.add_spline(model, lights=0, color=(1.0, 1.0, 1.0), **style)
-    pl.camera_position = CAMERA
-    pl.camera.clipping_range = (1.0, 8.0)
-    img = pl.screenshot().astype(np.float64) / 255.0
-    matrix = pl.camera_matrix()
-    pl.close()
-    return img, matrix
+_sphere, _render = sphere, render
 
 
 def _twin(model, matrix):
@@ -109,14 +86,10 @@ def test_highlight_lines_do_not_depend_on_the_eye(sphere):
     # same band (w = 0 there: on a band edge, so look just beside it, at the twin's hits of two views)
     a, ma = _render(sphere, highlight_lines=0.5, highlight_height=1.5, antialias=False)
     hits_a, _ = _twin(sphere, ma)
-    global CAMERA
-    saved = CAMERA
-    CAMERA = [(3.0, 0.2, 2.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
-    try:
-        b, mb = _render(sphere, highlight_lines=0.5, highlight_height=1.5, antialias=False)
-        hits_b, _ = _twin(sphere, mb)
-    finally:
-        CAMERA = saved
+    other_eye = [(3.0, 0.2, 2.2), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+    assert other_eye != CAMERA
+    b, mb = _render(sphere, camera=other_eye, highlight_lines=0.5, highlight_height=1.5, antialias=False)
+    hits_b, _ = _twin(sphere, mb)
     # pixels of the two views that see (nearly) the same surface point carry the same colour
     pa, pb = hits_a.points[hits_a.hit], hits_b.points[hits_b.hit]
     ca, cb = a[..., 0][hits_a.hit] > 0.5, b[..., 0][hits_b.hit] > 0.5

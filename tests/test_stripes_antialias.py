@@ -7,15 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import splinevis
 from splinevis.analysis.footprint import MAX_WIDTH, MIN_WIDTH, float32_bound, mean_deviation_bound, stripe_bright
 from splinevis.analysis.zebra import reflection_phase
 from splinevis.gl.camera import pixel_rays
 from splinevis.gl.harness import run_glsl
-from splinevis.io import VolumeGrid
 from splinevis.programs import program_for
-from splinevis.volume.isosurface import Isosurface
-from splinevis.volume.model import VolumeSpline
+from _sphere_scene import WINDOW, render, sphere
 
 pytestmark = pytest.mark.gl
 
@@ -59,28 +56,11 @@ def test_box_average_is_within_a_quarter_over_w_of_the_mean():
         assert abs(dev.max() - exact) <= 1e-4 / w + 1e-12  # the grid's step (1e-4) moves a box end by that
 
 
-N = 40
-WINDOW = (160, 120)
-CAMERA = [(2.6, -1.9, 1.7), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
 FINE = 400  # reflection-line pairs over a half turn: most of the sphere's pixels hold several
 
 
-def _sphere():
-    x = np.linspace(-1, 1, N)
-    z, y, xx = np.meshgrid(x, x, x, indexing="ij")
-    grid = VolumeGrid(np.sqrt(xx**2 + y**2 + z**2), spacing=(2 / (N - 1),) * 3, origin=(-1, -1, -1))
-    return Isosurface(VolumeSpline(grid), 0.7)
-
-
 def _render(model, antialias):
-    pl = splinevis.Plotter(off_screen=True, window_size=WINDOW)
-    pl.set_background("black")
-    pl.add_spline(model, lights=0, color=(1.0, 1.0, 1.0), reflection_lines=FINE, antialias=antialias)
-    pl.camera_position = CAMERA
-    pl.camera.clipping_range = (1.0, 8.0)
-    img = pl.screenshot().astype(np.float64) / 255.0
-    matrix = pl.camera_matrix()
-    pl.close()
+    img, matrix = render(model, reflection_lines=FINE, antialias=antialias)
     return img[..., 0], matrix
 
 
@@ -98,7 +78,7 @@ def _twin_footprint(model, matrix):
 
 
 def test_stripes_finer_than_a_pixel_render_to_their_mean():
-    model = _sphere()
+    model = sphere()
     filtered, matrix = _render(model, True)
     plain, _ = _render(model, False)
     w, ok = _twin_footprint(model, matrix)
