@@ -415,8 +415,10 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
                           + ("fairness tried (folds, distance): " + ", ".join(
                               f"{f:g}: " + ("folds not counted" if a != a else f"{100 * a:.2g}%") + f", {100 * b:.2g}%"
                               for f, (a, b) in folds["fairness_tried"].items())
-                             + f"; kept {fairness:g} (a stronger one moves the surface more than "
-                             f"{100 * AUTO_FAIRNESS_HAUSDORFF:g}% of the diagonal from the mesh)."
+                             + f"; kept {fairness:g} (" + (
+                                 f"a stronger one moves the surface more than {100 * AUTO_FAIRNESS_HAUSDORFF:g}% of "
+                                 "the diagonal from the mesh)." if list(folds["fairness_tried"].values())[-1][1]
+                                 > AUTO_FAIRNESS_HAUSDORFF else "the fewest folds of the weights tried).")
                              if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=2)
         if len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
             import warnings
