@@ -26,6 +26,8 @@ Cases
   ones always) from the file to the first frame, stage by stage, in fresh processes (``bench_nurbs_files.py``).
 * ``read_dem``: a 3000 x 3000 USGS ASCII DEM read by ``read_heights`` beside GDAL's USGSDEM driver and the same
   heights as GeoTIFF (``bench_read_dem.py``; 800 x 800 with ``--quick``).
+* ``import``: seconds of ``import splinevis`` and of the first ``Plotter(off_screen=True)`` in new processes, the
+  development install beside the wheel with only the core dependencies (``bench_import.py``).
 
 Each configuration is warmed up (first frame compiles shaders), then timed ``repeats`` times with the
 render window's Render() + WaitForCompletion(); min and median are reported. Ratios are taken against
@@ -263,6 +265,10 @@ def _markdown(results):
         from bench_read_dem import read_dem_markdown
 
         lines.append(read_dem_markdown(results["read_dem"]))
+    if "import" in results:
+        from bench_import import import_markdown
+
+        lines.append(import_markdown(results["import"]))
     return "\n".join(lines) + "\n"
 
 
@@ -280,6 +286,7 @@ def main(argv=None):
     info = gl_info()
     results = {"machine": f"{platform.node()} | {platform.processor() or platform.machine()} | {info['renderer']} | "
                           f"{info['window_class']} | Python {platform.python_version()}", "gl": info}
+    from bench_import import bench_import
     from bench_mesh_guided import bench_mesh_guided
     from bench_nurbs_files import bench_nurbs_files
     from bench_outofcore import bench_outofcore
@@ -291,7 +298,8 @@ def main(argv=None):
              ("volume", bench_volume), ("large_terrain", bench_large_terrain), ("cold_start", bench_cold_start),
              ("profile", bench_profile), ("mesh_guided", bench_mesh_guided), ("outofcore", bench_outofcore),
              ("nurbs_files", bench_nurbs_files),
-             ("read_dem", lambda repeats, quick: bench_read_dem(800 if quick else 3000, min(repeats, 3)))]
+             ("read_dem", lambda repeats, quick: bench_read_dem(800 if quick else 3000, min(repeats, 3))),
+             ("import", lambda repeats, quick: bench_import(3 if quick else repeats))]
     known = [name for name, _ in cases]
     if args.cases:
         unknown = sorted(set(args.cases) - set(known))

@@ -26,7 +26,7 @@ EXTRAS = {
     "pyiges": ("cad", "IGES files"),
     "OCP": ("cad", "STEP files and OpenCASCADE's tessellation"),
     "shapely": ("cad", "trimmed NURBS patches"),
-    "PythonCDT": ("cad", "trimmed NURBS patches"),
+    "pythoncdt": ("cad", "trimmed NURBS patches"),
     "igl": ("mesh", "geometry images of triangle meshes"),
     "pymeshlab": ("mesh", "decimation and subdivision of triangle meshes"),
     "dask": ("dask", "data past memory"),
