@@ -23,6 +23,22 @@ from .gl.vtk_errors import capture_vtk_errors, raise_for_shader_errors  # noqa: 
 
 __all__ = ["Plotter", "companion_polydata"]
 
+# Jupyter backends whose page renders with vtk.js (no GLSL of ours): why each is refused.
+_BROWSER_BACKENDS = {"client": "renders in the browser with vtk.js", "html": "exports the scene to vtk.js in the browser",
+                     "trame": "has a switch to rendering in the browser with vtk.js"}
+
+
+def _can_serve() -> bool:
+    """trame-pyvista is installed and an event loop runs in this thread (a Jupyter kernel's) to serve from."""
+    import asyncio
+    import importlib.util
+
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:
+        return False
+    return importlib.util.find_spec("trame_pyvista") is not None
+
 
 def companion_polydata(points, cells) -> pv.PolyData:
     """A :class:`pyvista.PolyData` of companion geometry: ``cells`` (m, 3) triangles, (m, 2) line segments or
@@ -443,9 +459,11 @@ class Plotter(pv.Plotter):
 
     def show(self, *args, jupyter_backend=None, **kwargs):
         """PyVista's :meth:`~pyvista.Plotter.show`. In Jupyter our programs render on the server: the ``static``
-        backend (a picture) and ``server`` (trame, rendered here, streamed) show them; ``client`` and ``html``
-        hand the scene to vtk.js in the browser, which knows nothing of our GLSL and would draw the proxies, so
-        they are refused (a spline-free scene may still use them: draw it with ``pyvista.Plotter``).
+        backend (a picture) and ``server`` (trame streams the pictures VTK renders here:
+        :mod:`splinevis.gl.trame_view`; the default in a Jupyter kernel when trame-pyvista is installed) show them.
+        ``client`` and ``html`` hand the scene to vtk.js in the browser, which knows nothing of our GLSL and would
+        draw the proxies, and ``trame`` offers a switch to it, so they are refused (a spline-free scene may still
+        use them: draw it with ``pyvista.Plotter``).
 
         >>> pl = Plotter(off_screen=True, window_size=(32, 24))
         >>> pl.show(jupyter_backend="client")
@@ -453,10 +471,15 @@ class Plotter(pv.Plotter):
         ValueError: jupyter_backend='client' renders in the browser with vtk.js, which drops splinevis's GLSL (the splines would show as their proxy boxes); use jupyter_backend='static' (a picture rendered here) or 'server' (trame, rendered here and streamed).
         """
         backend = jupyter_backend if jupyter_backend is not None else pv.global_theme.jupyter_backend
-        if isinstance(backend, str) and backend.lower() in ("client", "html"):
-            raise ValueError(f"jupyter_backend={backend!r} renders in the browser with vtk.js, which drops splinevis's "
-                             "GLSL (the splines would show as their proxy boxes); use jupyter_backend='static' (a "
-                             "picture rendered here) or 'server' (trame, rendered here and streamed).")
+        backend = backend.lower() if isinstance(backend, str) else backend
+        if backend in _BROWSER_BACKENDS:
+            raise ValueError(f"jupyter_backend={backend!r} {_BROWSER_BACKENDS[backend]}, which drops splinevis's GLSL "
+                             "(the splines would show as their proxy boxes); use jupyter_backend='static' (a picture "
+                             "rendered here) or 'server' (trame, rendered here and streamed).")
+        if self.notebook and (backend == "server" or (backend is None and _can_serve())):
+            from .gl import trame_view
+
+            jupyter_backend = trame_view.register()
         return super().show(*args, jupyter_backend=jupyter_backend, **kwargs)
 
     def render(self) -> None:

@@ -9,8 +9,9 @@ job="${1:-setup}"
 shift || true
 
 # OpenGL on the CPU (Mesa llvmpipe): EGL for VTK and moderngl, OSMesa as VTK's fallback window; Xvfb (and xauth,
-# which xvfb-run needs) for the test of the interactive window on a virtual display.
-DEB_PACKAGES=(libegl1 libegl-mesa0 libgl1-mesa-dri libgl1 libosmesa6 xvfb xauth)
+# which xvfb-run needs) for the test of the interactive window on a virtual display; chromium (headless) loads the
+# page of the Jupyter 'server' backend in its test.
+DEB_PACKAGES=(libegl1 libegl-mesa0 libgl1-mesa-dri libgl1 libosmesa6 xvfb xauth chromium)
 PY="${PYTHON:-python3}"
 
 as_root() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
