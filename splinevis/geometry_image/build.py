@@ -327,6 +327,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
             raise ValueError(f"sphere_map is not a parametrization of {name}: its points differ from the mesh's.")
 
     t0 = time.perf_counter()
+    from .._reproducible import mat
     from .image import image_uv, octahedral_to_sphere
 
     if isinstance(orientation, str) and orientation == "auto":
@@ -357,7 +358,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         k = auto_oversample(n, info["vertices"]) if isinstance(oversample, str) and oversample == "auto" else oversample
         M = int(k) * (int(n) - 1) + 1
         # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
-        samples = surface_points(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3) @ R).reshape(M, M, 3)
+        samples = surface_points(smap, mat(octahedral_to_sphere(image_uv(M)).reshape(-1, 3), R)).reshape(M, M, 3)
         seconds["sample"] = seconds.get("sample", 0.0) + time.perf_counter() - t0
 
         t0 = time.perf_counter()

@@ -11,8 +11,9 @@ a spherical parametrization, or any map from unit directions to points), and the
 of its four neighbours in the closed mesh, ``L`` rows) and ``lambda`` the fairness weight. The unknowns are the
 *free* control points: one per class of samples the X-cut identifies, the four cut vertices eliminated as the
 centroids of their neighbours [Losasso2003, eq. 2], so every fitted image is ``C^1`` at the cut vertices by
-construction. The normal equations are solved by conjugate gradients (Jacobi-preconditioned), one solve per
-coordinate.
+construction. The normal equations are solved by conjugate gradients (Jacobi-preconditioned,
+[HestenesStiefel1952]), the three coordinates at once, with inner products in a fixed order
+(:func:`splinevis._reproducible.conjugate_gradients`: the same image on every machine).
 
 **Why one fairness weight for all control points.** Both terms are averages over the image, so where the
 control points are ``h`` apart in 3-D the fairness term is ``lambda (h^2 / 4)^2 |Lap g|^2`` per unit of
@@ -40,6 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._reproducible import conjugate_gradients
 from .image import cut_neighbours, cut_vertices, image_uv, octahedral_to_sphere, pad
 from .model import GeometryImage
 
@@ -169,8 +171,6 @@ def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample
     (True, True)
     """
     from scipy.interpolate import NdBSpline
-    from scipy.sparse import diags
-    from scipy.sparse.linalg import cg
 
     if not fairness >= 0.0:
         raise ValueError(f"fairness must be >= 0, got {fairness!r}.")
@@ -209,26 +209,18 @@ def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample
     K, L = A.shape[0], F.shape[0]
     normal = (A.T @ A) / K + (fairness / L) * (F.T @ F)
     rhs = (A.T @ X) / K
-    jacobi = diags(1.0 / normal.diagonal())
     seconds["assemble"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     x0 = X.reshape(M, M, 3)[::oversample, ::oversample].reshape(-1, 3)[free]
-    x = np.empty_like(x0)
-    iterations = []
-    for axis in range(3):
-        count = [0]
-
-        def step(_xk):
-            count[0] += 1
-
-        sol, info = cg(normal, rhs[:, axis], x0=x0[:, axis], rtol=rtol, atol=0.0, M=jacobi,
-                       maxiter=20 * normal.shape[0], callback=step)
-        if info != 0:
-            raise ValueError(f"conjugate gradients did not converge for coordinate {'xyz'[axis]} in {count[0]} "
-                             "iterations; the samples may be degenerate (all on a plane or a line).")
-        x[:, axis] = sol
-        iterations.append(count[0])
+    x, iterations = conjugate_gradients(normal, rhs, x0, diagonal=normal.diagonal(), rtol=rtol,
+                                        maxiter=20 * normal.shape[0])
+    for axis, count in enumerate(iterations):
+        if count < 0:
+            raise ValueError(f"conjugate gradients did not converge for coordinate {'xyz'[axis]} in "
+                             f"{20 * normal.shape[0]} iterations; the samples may be degenerate (all on a plane "
+                             "or a line).")
+    iterations = tuple(iterations)
     seconds["solve"] = time.perf_counter() - t0
 
     G = (S @ x).reshape(N + 1, N + 1, 3)
@@ -237,4 +229,4 @@ def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample
     rough = float((np.linalg.norm(F @ x, axis=1) ** 2).mean()) / diag ** 2
     image = GeometryImage(G)
     return FitResult(image, float(fairness), float(np.sqrt((res ** 2).mean())), float(res.max()), rough,
-                     tuple(iterations), seconds)
+                     iterations, seconds)

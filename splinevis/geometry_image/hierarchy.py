@@ -39,6 +39,8 @@ import time
 
 import numpy as np
 
+from .._reproducible import solve_small
+
 from .relax import DET_BOUND, _det, _relax, _unit
 from .tutte import _start_vertices, _tutte_sphere
 
@@ -267,7 +269,7 @@ def _center_inserted(X, removed, T, owner, iterations: int = 60):
         E = np.stack([e1, e2], axis=2)  # (m, 3, 2)
         gt = np.einsum("mik,mi->mk", E, g)
         Ht = np.einsum("mik,mij,mjl->mkl", E, H, E) + 1e-300 * np.eye(2)
-        newton = np.linalg.solve(Ht, gt[..., None])[..., 0]
+        newton = solve_small(Ht, gt)
         step = np.einsum("mik,mk->mi", E, newton)
         # the Newton decrement squared, g . H^-1 g: the barrier's rise still to come is about half of it; below
         # 1e-3 a vertex is at its centre for our purpose (the relaxation moves it on anyway)

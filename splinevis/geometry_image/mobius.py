@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._reproducible import dot, norm, solve_small, weighted_sum
+
 __all__ = ["mobius_transform", "center_on_sphere"]
 
 
@@ -34,10 +36,10 @@ def mobius_transform(X, c) -> np.ndarray:
     """
     X = np.asarray(X, dtype=np.float64)
     c = np.asarray(c, dtype=np.float64)
-    if not np.linalg.norm(c) < 1.0:
-        raise ValueError(f"a Möbius transformation of the sphere needs |c| < 1, got |c| = {np.linalg.norm(c):.6g}.")
+    if not norm(c) < 1.0:
+        raise ValueError(f"a Möbius transformation of the sphere needs |c| < 1, got |c| = {norm(c):.6g}.")
     y = X + c
-    Y = (1.0 - c @ c) * y / (y * y).sum(axis=1, keepdims=True) + c
+    Y = (1.0 - dot(c, c)) * y / (y * y).sum(axis=1, keepdims=True) + c
     return Y / np.linalg.norm(Y, axis=1, keepdims=True)  # remove rounding off the sphere
 
 
@@ -55,18 +57,20 @@ def center_on_sphere(X, mass, *, tol: float = 1e-12, max_steps: int = 200) -> np
     X = np.asarray(X, dtype=np.float64)
     w = np.asarray(mass, dtype=np.float64)
     w = w / w.sum()
-    mu = w @ X
+    mu = weighted_sum(w, X)
     for _ in range(int(max_steps)):
-        if np.linalg.norm(mu) < tol:
+        if norm(mu) < tol:
             break
         J = 2.0 * (np.eye(3) - np.einsum("i,ij,ik->jk", w, X, X))
-        c = -np.linalg.lstsq(J, mu, rcond=None)[0]
-        if np.linalg.norm(c) > 0.5:
-            c *= 0.5 / np.linalg.norm(c)
+        c = -solve_small(J, mu)  # J is positive definite unless all points lie on one line
+        if not np.all(np.isfinite(c)):
+            break
+        if norm(c) > 0.5:
+            c *= 0.5 / norm(c)
         for _ in range(60):
             Y = mobius_transform(X, c)
-            mu_new = w @ Y
-            if np.linalg.norm(mu_new) < np.linalg.norm(mu):
+            mu_new = weighted_sum(w, Y)
+            if norm(mu_new) < norm(mu):
                 break
             c *= 0.5
         else:

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._reproducible import dot, mat, norm
+
 from .image import sphere_to_octahedral
 
 __all__ = ["rotation_between", "sampling_criterion", "best_orientation"]
@@ -33,9 +35,9 @@ TURNS = (0.0, np.pi / 8, np.pi / 4, 3 * np.pi / 8)
 
 def _axis_rotation(axis, angle):
     a = np.asarray(axis, dtype=np.float64)
-    a = a / np.linalg.norm(a)
+    a = a / norm(a)
     K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * mat(K, K)
 
 
 def rotation_between(a, b) -> np.ndarray:
@@ -48,9 +50,9 @@ def rotation_between(a, b) -> np.ndarray:
     """
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
-    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    a, b = a / norm(a), b / norm(b)
     v = np.cross(a, b)
-    s, c = np.linalg.norm(v), float(a @ b)
+    s, c = norm(v), dot(a, b)
     if s < 1e-12:
         if c > 0:
             return np.eye(3)
@@ -74,7 +76,7 @@ def sampling_criterion(points, faces, sphere, R) -> float:
     P = np.asarray(points, dtype=np.float64)
     F = np.asarray(faces)
     mesh_area = 0.5 * np.linalg.norm(np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]), axis=1)
-    uv = sphere_to_octahedral(np.asarray(sphere, dtype=np.float64) @ np.asarray(R).T)[F]
+    uv = sphere_to_octahedral(mat(sphere, np.asarray(R).T))[F]
     keep = np.ptp(uv, axis=1).max(axis=1) < 0.5  # across a border of the square: not a triangle of the image
     e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
     image_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
@@ -103,7 +105,7 @@ def best_orientation(sphere_map):
     for name, target in TARGETS.items():
         to_target = rotation_between(worst, target)
         for turn in TURNS:
-            candidates.append((f"{name} turned {np.degrees(turn):g} deg", _axis_rotation(target, turn) @ to_target))
+            candidates.append((f"{name} turned {np.degrees(turn):g} deg", mat(_axis_rotation(target, turn), to_target)))
     rows = [{"candidate": name, "criterion": sampling_criterion(P, F, S, R)} for name, R in candidates]
     best = min(range(len(rows)), key=lambda i: rows[i]["criterion"])
     return candidates[best][1], rows

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._reproducible import dot, spd_factor
+
 __all__ = ["DET_BOUND"]
 
 #: Smallest ``det[a, b, c]`` of unit vectors that counts as outward: the rounding error of ``a . (b x c)`` is at
@@ -18,6 +20,11 @@ __all__ = ["DET_BOUND"]
 #: of the cross product, three products and two sums in the dot product; ``u`` the unit roundoff, first order,
 #: Cauchy-Schwarz), so a computed det above ``8 u`` is positive in exact arithmetic too.
 DET_BOUND = 8 * np.finfo(np.float64).eps / 2
+
+#: Largest change of the spherical triangles' area sum a step may make: a step that keeps every triangle outward
+#: can still jump (vertices move up to half a radian) to a map covering the sphere twice, whose areas sum to
+#: ``8 pi``; rounding moves the sum by ``~1e-16`` per triangle, far below this and far below the ``4 pi`` jump.
+DEGREE_TOLERANCE = 1e-6
 
 #: The relaxation factors its preconditioner anew every this many steps.
 REFACTOR = 4
@@ -65,11 +72,10 @@ def _relax(X, S, iterations, progress, tol, memory=8):
     [Nocedal1980] on the tangent planes, with the
     preconditioner as the initial inverse Hessian. A step that does not lower the energy enough (Armijo) is
     halved; where it would flip a triangle it is halved for that triangle's vertices (:func:`_safe_step`)."""
-    from scipy.sparse.linalg import splu
-
     F = S.F
     incident = (S.gather @ _corner_face(len(F))).tocsr()  # vertex -> its triangles
     E, g, sph = S.gradient(X)
+    area_start = float(np.add.reduce(sph))  # 4 pi times the degree: every accepted step keeps it
     g = _tangent(g, X)
     bar = None
     if progress:
@@ -79,42 +85,41 @@ def _relax(X, S, iterations, progress, tol, memory=8):
     steps, history, energies = 0, [], [E]
     for _ in range(iterations):
         if steps % REFACTOR == 0:  # the preconditioner changes slowly: factor it every REFACTOR-th step
-            # symmetric positive definite: a symmetric ordering and no pivoting (SuperLU's symmetric mode)
-            lu = splu(S.preconditioner(sph), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                      options={"SymmetricMode": True})
+            # symmetric positive definite: a sparse Cholesky factor (Eigen's: the same bits on every machine)
+            solve = spd_factor(S.preconditioner(sph))
         # two-loop recursion
         q = g.copy()
         alphas = []
         for s_k, y_k, rho in reversed(history):
-            a = rho * np.vdot(s_k, q)
+            a = rho * dot(s_k, q)
             q -= a * y_k
             alphas.append(a)
-        r = lu.solve(q)
+        r = solve(q)
         if history:
             s_k, y_k, _ = history[-1]
-            r *= np.vdot(s_k, y_k) / max(np.vdot(y_k, lu.solve(y_k)), 1e-300)
+            r *= dot(s_k, y_k) / max(dot(y_k, solve(y_k)), 1e-300)
         for (s_k, y_k, rho), a in zip(history, reversed(alphas)):
-            r += (a - rho * np.vdot(y_k, r)) * s_k
+            r += (a - rho * dot(y_k, r)) * s_k
         d = -_tangent(r, X)
-        slope = float(np.vdot(g, d))
+        slope = float(dot(g, d))
         if slope >= 0 or not np.isfinite(slope):
             history = []
-            d = -_tangent(lu.solve(g), X)
-            slope = float(np.vdot(g, d))
+            d = -_tangent(solve(g), X)
+            slope = float(dot(g, d))
             if slope >= 0:
                 break
         if history:
             step = 1.0
         else:  # no curvature pairs yet: minimize the quadratic model along d (its curvature from a small step)
             eps = 1e-4 / max(np.abs(d).max(), 1e-300)
-            curv = float(np.vdot(_tangent(S.gradient(_unit(X + eps * d))[1], X) - g, d)) / eps
+            curv = float(dot(_tangent(S.gradient(_unit(X + eps * d))[1], X) - g, d)) / eps
             step = -slope / curv if curv > 0 else 1.0
         step = min(step, 0.5 / np.linalg.norm(d, axis=1).max())  # no vertex moves more than half a radian
         accepted = False
         for _ in range(40):
             Y = _safe_step(X, d, np.full(len(X), step), F, incident)
-            E_new = S.energy(Y)
-            if E_new <= E + 1e-4 * step * slope:
+            E_new, area = S.energy_and_area(Y)
+            if E_new <= E + 1e-4 * step * slope and abs(area - area_start) <= DEGREE_TOLERANCE:
                 accepted = True
                 break
             step *= 0.5
@@ -127,8 +132,8 @@ def _relax(X, S, iterations, progress, tol, memory=8):
         E, g_new, sph = S.gradient(Y)
         g_new = _tangent(g_new, Y)
         s_k, y_k = Y - X, g_new - _tangent(g, Y)
-        sy = np.vdot(s_k, y_k)
-        if sy > 1e-12 * np.vdot(s_k, s_k) ** 0.5 * np.vdot(y_k, y_k) ** 0.5:
+        sy = dot(s_k, y_k)
+        if sy > 1e-12 * dot(s_k, s_k) ** 0.5 * dot(y_k, y_k) ** 0.5:
             history = (history + [(s_k, y_k, 1.0 / sy)])[-memory:]
         X, g = Y, g_new
         if len(energies) > MIN_STEPS and energies[-6] - E < 5 * tol * E:  # under tol a step over the last 5 steps

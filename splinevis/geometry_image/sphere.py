@@ -23,7 +23,8 @@ It is built in three stages, each of which keeps it one-to-one:
    measured on spherical triangle areas (:mod:`.stretch`), grows without bound as a spherical triangle
    degenerates, so descending it keeps the triangles apart. The descent is L-BFGS [Nocedal1980] on the tangent planes, the points put back on the sphere
    after each step, with :meth:`.stretch.StretchEnergy.preconditioner` as the initial inverse Hessian
-   (factored every 4th step, by SuperLU in its symmetric mode). A step must lower the energy (Armijo); where it would flip a triangle it is
+   (factored every 4th step by Eigen's sparse Cholesky, whose bits, unlike SuperLU's, do not follow the machine's BLAS;
+   every inner product in a fixed order, :mod:`splinevis._reproducible`). A step must lower the energy (Armijo); where it would flip a triangle it is
    halved for that triangle's vertices until none flips (:func:`_safe_step`).
 
 The result is checked, not assumed, to be one-to-one: every triangle must have ``det[a, b, c] > DET_BOUND``
