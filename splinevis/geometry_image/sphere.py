@@ -27,6 +27,12 @@ It is built in three stages, each of which keeps it one-to-one:
    every inner product in a fixed order, :mod:`splinevis._reproducible`). A step must lower the energy (Armijo); where it would flip a triangle it is
    halved for that triangle's vertices until none flips (:func:`_safe_step`).
 
+   Why the L2 stretch and not a higher power of it (toward Sander et al.'s L-infinity stretch): weighting the
+   largest stretches more lowers them, but not the folds of the fitted image. Measured on the nefertiti scan
+   (n = 257, the folds counted as :mod:`.judge` does): ``sum area s^2`` (``s`` the squared per-triangle
+   stretch, normalized) took the largest stretch from 5.49 to 3.25 and the mean from 1.208 to 1.188, and the
+   folded limit triangles at fairness 0.1 from 0.054 % to 0.20 % (0.0093 % to 0.0185 % at the fairness kept).
+
 The result is checked, not assumed, to be one-to-one: every triangle must have ``det[a, b, c] > DET_BOUND``
 (outward oriented beyond rounding), and the spherical triangles' areas must sum to ``4 pi``. That sum is ``4 pi`` times the map's
 degree, so it tells a one-to-one map from one wrapping the sphere twice without flipping a triangle; the
