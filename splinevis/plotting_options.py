@@ -15,8 +15,9 @@ from .effects import Style
 __all__ = ["READ_KEYWORDS", "PYVISTA_ALIASES", "PYVISTA_REFUSED"]
 
 
-#: Keywords of ``add_terrain`` / ``add_isosurface`` that go to the reader: a numpy array's lattice.
-READ_KEYWORDS = ("spacing", "origin")
+#: Keywords of ``add_terrain`` / ``add_isosurface`` that go to the reader: a numpy array's lattice and (a volume's)
+#: axis order.
+READ_KEYWORDS = ("spacing", "origin", "order")
 #: PyVista's keyword names that mean one of ours.
 PYVISTA_ALIASES = {"cmap": "colormap", "clim": "scalar_range"}
 #: PyVista's keywords that do not apply to an exact surface, and why.

@@ -83,7 +83,7 @@ def test_layout_values_kji_at_origin_plus_ijk_spacing(tmp_path):
     nz, ny, nx = 3, 4, 5
     k, j, i = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
     a = (100 * k + 10 * j + i).astype(np.int32)
-    g = read_volume(a, spacing=(0.5, 2.0, 3.0), origin=(1.0, 2.0, 3.0))
+    g = read_volume(a, order="zyx", spacing=(0.5, 2.0, 3.0), origin=(1.0, 2.0, 3.0))
     assert g.values[2, 1, 4] == 214 and g.to_world([4, 1, 2]).tolist() == [3.0, 4.0, 9.0]
     img = g.to_pyvista()
     p = img.points[np.argmax(img.point_data["values"] == 214)]
@@ -95,12 +95,88 @@ def test_layout_values_kji_at_origin_plus_ijk_spacing(tmp_path):
 # ---- numpy, pyvista ----------------------------------------------------------------------------------
 def test_numpy_defaults_copy_and_scalar_spacing():
     a = np.arange(24.0).reshape(2, 3, 4)
-    g = read_volume(a)
+    g = read_volume(a, order="zyx")
     assert g.spacing == (1.0, 1.0, 1.0) and g.origin == (0.0, 0.0, 0.0) and g.source == "numpy array"
     assert g.dtype == "float64" and not g.values.flags.writeable
     a[0, 0, 0] = 99
     assert g.values[0, 0, 0] == 0
     assert read_volume(np.zeros((2, 2, 2)), spacing=0.25).spacing == (0.25, 0.25, 0.25)
+
+
+def _read_recording(*args, **kwargs):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        grid = read_volume(*args, **kwargs)
+    return grid, caught
+
+
+def test_default_order_xyz_places_every_sample_where_pyvista_wrap_does():
+    a = values_of("float64", (4, 3, 5), seed=3)  # nx, ny, nz = 4, 3, 5 read as x first
+    spacing, origin = (0.5, 2.0, 3.0), (1e6, -2.0, 5.0)
+    wrapped = pv.wrap(a)
+    wrapped.spacing, wrapped.origin = spacing, origin
+    for kwargs in ({"order": "xyz"}, {}):
+        g, caught = _read_recording(a, spacing=spacing, origin=origin, **kwargs)
+        assert len(caught) == (0 if kwargs else 1)
+        mine = g.to_pyvista()
+        assert mine.dimensions == wrapped.dimensions == (4, 3, 5)
+        # both x fastest: the same points in the same order carry the same values (exact: no arithmetic)
+        np.testing.assert_array_equal(mine.points, wrapped.points)
+        np.testing.assert_array_equal(mine.point_data["values"], wrapped.active_scalars)
+    assert g.values[4, 2, 3] == a[3, 2, 4]  # values[k, j, i] = arr[i, j, k]
+
+
+def test_zyx_reads_the_transpose_and_components_stay_last():
+    a = values_of("int16", (3, 4, 5), seed=4)
+    np.testing.assert_array_equal(read_volume(a, order="zyx").values, read_volume(a.transpose(2, 1, 0),
+                                                                                    order="xyz").values)
+    v = np.stack([a, -a], axis=-1)  # (nz, ny, nx, 2)
+    np.testing.assert_array_equal(read_volume(v.transpose(2, 1, 0, 3), order="xyz", component=1).values, -a)
+    assert read_volume(a.tolist(), order="zyx").shape == (3, 4, 5)  # nested lists are arrays too
+
+
+def test_omitted_order_warns_only_when_the_two_readings_differ():
+    g, caught = _read_recording(np.zeros((3, 4, 5)))
+    (w,) = caught
+    assert w.filename == __file__  # the user's line, not splinevis's
+    assert ("shape (3, 4, 5) read without order=, as order='xyz' (arr[i, j, k], as pyvista.wrap): nx, ny, nz = 3, 4, "
+            "5; order='zyx' (arr[k, j, i], splinevis's former default) reads nx, ny, nz = 5, 4, 3") in str(w.message)
+    assert g.shape == (5, 4, 3)
+    z, y, x = np.mgrid[-1:1:6j, -1:1:7j, -1:1:6j]
+    _, caught = _read_recording(x + 2 * z)  # a cube's shape either way, other values
+    assert len(caught) == 1 and "reads the same nx, ny, nz, but x and z swapped" in str(caught[0].message)
+    # symmetric in x and z up to the rounding of the sum's order: either reading is the same volume
+    _, caught = _read_recording(x ** 2 + y ** 2 + z ** 2)
+    assert caught == []
+    for order in ("xyz", "zyx"):
+        assert _read_recording(np.zeros((3, 4, 5)), order=order)[1] == []
+
+
+def test_order_is_checked_and_only_for_arrays(tmp_path):
+    with pytest.raises(ValueError, match=r"order 'kji' is not known; choose 'xyz' \(arr\[i, j, k\], as pyvista"):
+        read_volume(np.zeros((2, 2, 2)), order="kji")
+    img = pv.ImageData(dimensions=(2, 2, 2))
+    img.point_data["v"] = np.zeros(8)
+    with pytest.raises(ValueError, match=r"order= gives the axis order of a numpy array; an ImageData carries its own"):
+        read_volume(img, order="xyz")
+    write_volume(VolumeGrid(np.zeros((2, 2, 2))), tmp_path / "a.nrrd")
+    with pytest.raises(ValueError, match=r"a\.nrrd carries its own\. Drop the argument"):
+        read_volume(tmp_path / "a.nrrd", order="zyx")
+
+
+@pytest.mark.gl
+def test_spline_and_plotter_take_the_order_of_an_array():
+    from splinevis.plotting import Plotter
+    from splinevis.volume.model import VolumeSpline
+
+    a = values_of("float64", (4, 3, 5), seed=5)
+    for order in ("xyz", "zyx"):
+        want = read_volume(a, order=order, spacing=(0.5, 1.0, 2.0)).values
+        np.testing.assert_array_equal(VolumeSpline(a, order=order, spacing=(0.5, 1.0, 2.0)).grid.values, want)
+        pl = Plotter(off_screen=True, window_size=(32, 24))
+        actor = pl.add_isosurface(a, float(np.median(a)), order=order, spacing=(0.5, 1.0, 2.0))
+        np.testing.assert_array_equal(actor.model.spline.grid.values, want)
+        pl.close()
 
 
 def test_pyvista_and_vtk_image_with_anisotropic_spacing():
@@ -356,14 +432,14 @@ def test_nan_error_names_voxel_world_position_and_fill():
     with pytest.raises(ValueError, match=r"numpy array: 2 of 60 samples are NaN/inf; the first at voxel \[k, j, i\] = "
                                          r"\[0, 0, 0\], world \(x, y, z\) = \(1000000\.0, 0\.0, 0\.0\), value inf\. "
                                          r"Pass fill='nearest' .* or a number, e\.g\. fill=0\.0"):
-        read_volume(a, origin=(1e6, 0.0, 0.0))
+        read_volume(a, order="zyx", origin=(1e6, 0.0, 0.0))
     a[0, 0, 0] = 0.0
     with pytest.raises(ValueError, match=r"\[2, 1, 3\], world \(x, y, z\) = \(1\.5, 2\.0, 6\.0\)"):
-        read_volume(a, spacing=(0.5, 2.0, 3.0))
+        read_volume(a, order="zyx", spacing=(0.5, 2.0, 3.0))
     # nearest in world distance: x neighbours (0.5 away) beat z neighbours (3 away)
-    g = read_volume(a, spacing=(0.5, 2.0, 3.0), fill="nearest")
+    g = read_volume(a, order="zyx", spacing=(0.5, 2.0, 3.0), fill="nearest")
     assert g.values[2, 1, 3] in (a[2, 1, 2], a[2, 1, 4])
-    assert read_volume(a, fill=-1.0).values[2, 1, 3] == -1.0
+    assert read_volume(a, order="zyx", fill=-1.0).values[2, 1, 3] == -1.0
     with pytest.raises(ValueError, match="fill 'mean' is not known; choose 'nearest' or a finite number"):
         read_volume(a, fill="mean")
 
@@ -383,7 +459,7 @@ def test_nan_position_after_flip_is_in_the_returned_grid(tmp_path):
 @pytest.mark.parametrize("value, kwargs, exc, match", [
     (np.zeros((4, 5)), {}, ValueError, r"3-D array \(nz, ny, nx\), got shape \(4, 5\)\. A 2-D image is a height "
                                        r"field: use splinevis\.io\.read_heights"),
-    (np.zeros((1, 4, 5)), {}, ValueError, r"at least 2 samples on every axis; shape \(nz, ny, nx\) = \(1, 4, 5\) has 1 "
+    (np.zeros((1, 4, 5)), {"order": "zyx"}, ValueError, r"at least 2 samples on every axis; shape \(nz, ny, nx\) = \(1, 4, 5\) has 1 "
                                           r"along z\. A single slice"),
     (np.zeros((2, 2, 2), dtype=complex), {}, TypeError, "real numbers, got dtype complex128"),
     (np.array([[["a", "b"]] * 2] * 2), {}, TypeError, r"\(strings\)"),

@@ -139,7 +139,7 @@ def test_store_on_a_distributed_cluster(tmp_path):
     assert _close(s.coefficients[...], model.coefficients)
     for L in range(s.depth + 1):
         assert _close(s.level(L)[0], model.hierarchy.levels[L][0])
-    vm = VolumeSpline(_dem((6, 7))[:6, :7, None] * np.ones(8), "quadratic")
+    vm = VolumeSpline(_dem((6, 7))[:6, :7, None] * np.ones(8), "quadratic", order="zyx")
     assert (v.padded[...] == vm.padded).all() and (v.level(0)[1] == vm.cube_ranges()[1]).all()
 
 
@@ -149,7 +149,7 @@ def test_volume_chunks_equal_in_memory(tmp_path, scheme):
     ref = spline_coefficients(v, scheme)
     assert (volume_coefficients_dask(v, scheme, chunks=8).compute() == ref).all()  # even x tiles: bit for bit
     assert _close(volume_coefficients_dask(v, scheme, chunks=(5, 6, 7)).compute(), ref)
-    model = VolumeSpline(v, scheme)
+    model = VolumeSpline(v, scheme, order="zyx")
     lo, hi = model.cube_ranges()
     r = volume_cube_ranges_dask(v, scheme, chunks=(6, 7, 9)).compute()
     assert (r[..., 0] == lo).all() and (r[..., 1] == hi).all()

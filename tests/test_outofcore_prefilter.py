@@ -14,7 +14,7 @@ from splinevis.volume.model import VolumeSpline
 @pytest.mark.parametrize("scheme,padding", [("quadratic", "quadratic"), ("cubic", "cubic")])
 def test_prefiltered_store_equals_the_in_memory_spline(tmp_path, scheme, padding):
     v = np.random.default_rng(3).random((9, 8, 10))
-    model = VolumeSpline(v, scheme, prefilter="local", padding=padding)
+    model = VolumeSpline(v, scheme, prefilter="local", padding=padding, order="zyx")
     # chunks of every size, the prefilter's halo crossing sample chunks
     P = padded_volume_dask(v, chunks=(3, 5, 4), scheme=scheme, prefilter="local", padding=padding).compute()
     assert np.array_equal(P, model.padded)
@@ -29,7 +29,7 @@ def test_prefiltered_store_equals_the_in_memory_spline(tmp_path, scheme, padding
     cubes = np.array([[0, 0, 0], [5, 7, 4], [3, 2, 1]])
     assert np.array_equal(w.cube_coefficients(cubes), model.cube_coefficients(cubes + [4, 0, 4]))
     # the prefilter is what the store holds: not the plain scheme's data
-    assert not np.array_equal(store.padded[...], VolumeSpline(v, scheme).padded)
+    assert not np.array_equal(store.padded[...], VolumeSpline(v, scheme, order="zyx").padded)
 
 
 def test_global_interpolation_is_refused_tile_by_tile(tmp_path):

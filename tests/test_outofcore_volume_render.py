@@ -32,7 +32,7 @@ def test_window_is_the_in_memory_spline_of_its_cubes(samples, store, tmp_path, s
     s = store if scheme == "quadratic" else write_volume_store(tmp_path / "c.zarr", samples, "cubic", chunks=TILE,
                                                                spacing=(0.5, 0.5, 0.5), origin=(-3.0, 1.0, 2.0),
                                                                progress=False)
-    full = VolumeSpline(samples, scheme, spacing=(0.5, 0.5, 0.5), origin=(-3.0, 1.0, 2.0))
+    full = VolumeSpline(samples, scheme, order="zyx", spacing=(0.5, 0.5, 0.5), origin=(-3.0, 1.0, 2.0))
     rng = np.random.default_rng(0)
     # inside (neighbouring samples as the layer), at the lower and the upper border (the store's padding)
     for k0, k1, j0, j1, i0, i1 in [(1, 2, 1, 2, 1, 2), (0, 2, 0, 1, 1, 3), (1, 3, 2, 3, 0, 3)]:
@@ -62,7 +62,7 @@ def test_window_is_the_in_memory_spline_of_its_cubes(samples, store, tmp_path, s
 def test_decimated_level_is_the_spline_of_every_2_to_the_L_th_sample(samples, store):
     for L in (1, 2):
         st = 1 << L
-        ref = VolumeSpline(samples[::st, ::st, ::st], "quadratic")  # its padding: linear extrapolation
+        ref = VolumeSpline(samples[::st, ::st, ::st], "quadratic", order="zyx")  # padding: linear extrapolation
         n = ref.shape[0]
         for q in [(slice(0, n),) * 3, (slice(2, n - 1), slice(0, 4), slice(1, n))]:
             P = rv._level_padded(store, L, q)
@@ -71,7 +71,7 @@ def test_decimated_level_is_the_spline_of_every_2_to_the_L_th_sample(samples, st
 
 
 def test_bricks_in_view_hold_the_isovalue(samples, store):
-    full = VolumeSpline(samples, "quadratic")
+    full = VolumeSpline(samples, "quadratic", order="zyx")
     lo, hi = full.cube_ranges()
     t = TILE
     b = rv.view_bricks(store, ISO, "all")
@@ -122,7 +122,7 @@ def test_camera_view_reads_its_bricks_and_draws_the_in_memory_isosurface(samples
     assert view.level == 0 and sorted(reads) == sorted(expect) and len(reads) == view.read
     assert 0 < len(reads) < len(everything)
     # the whole in-memory isosurface from the same camera
-    full = VolumeSpline(samples, "quadratic", spacing=(0.5, 0.5, 0.5), origin=(-3.0, 1.0, 2.0))
+    full = VolumeSpline(samples, "quadratic", order="zyx", spacing=(0.5, 0.5, 0.5), origin=(-3.0, 1.0, 2.0))
     pl = splinevis.Plotter(off_screen=True, window_size=(200, 150))
     pl.add_spline(Isosurface(full, ISO), lights=1)
     pl.camera_position = CAMERA
@@ -161,7 +161,7 @@ def test_level_fits_the_budget_and_the_texture(samples, store, monkeypatch):
     assert (b[1], b[3]) == (-3.0 + 9.5 * 2.0, 1.0 + 9.5 * 2.0)  # sample 36 and half a cube of 2: the level's end
     assert v.isosurface.spline.origin.tolist() == [-3.0, 1.0, 2.0]  # sample 0 is the store's
     # it is the spline of every 4th sample over those cubes
-    ref = VolumeSpline(samples[::4, ::4, ::4], "quadratic")
+    ref = VolumeSpline(samples[::4, ::4, ::4], "quadratic", order="zyx")
     assert np.array_equal(v.isosurface.spline.padded, ref.padded[:11, :12, :12])
     pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
     actor = pl.add_isosurface_store(store, ISO, "all", level=2, lights=1)
@@ -177,7 +177,7 @@ def test_a_thin_last_brick_is_drawn_with_its_neighbours_cubes(tmp_path):
     z, y, x = np.mgrid[0:34, 0:34, 0:34].astype(float)
     f = np.sin(x / 3) + y / 10 + z / 20
     s = write_volume_store(tmp_path / "s.zarr", f, chunks=16, progress=False)
-    full = VolumeSpline(f)
+    full = VolumeSpline(f, order="zyx")
     iso = float(full.evaluate([[32.5, 32.5, 32.5]])[0])  # a surface through the last brick
     v = rv.load_volume_view(s, iso, np.array([[2, 2, 2]]))
     assert v.level == 0 and v.read == 1 and v.cubes == (slice(31, 34),) * 3  # one cube of brick 1 per axis

@@ -119,7 +119,7 @@ def test_nan_voxels_are_refused_with_their_position():
     v = np.zeros((5, 5, 5))
     v[1, 2, 3] = np.nan
     with pytest.raises(ValueError, match=r"\[1, 2, 3\]"):
-        VolumeSpline(v)
+        VolumeSpline(v, order="zyx")
 
 
 def test_options_are_validated():

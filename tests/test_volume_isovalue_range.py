@@ -21,7 +21,7 @@ def _gaussian(sigma=1.2):
 def test_coefficient_range_is_that_of_every_coefficient(scheme):
     # the pruned search (cubes by their float32 bound, best first) against all coefficients of all cubes
     rng = np.random.default_rng(3)
-    s = VolumeSpline(rng.standard_normal((7, 6, 5)), scheme)
+    s = VolumeSpline(rng.standard_normal((7, 6, 5)), scheme, order="zyx")
     nz, ny, nx = s.shape
     k, j, i = np.mgrid[0:nz, 0:ny, 0:nx]
     every = s.cube_coefficients(np.column_stack([i.ravel(), j.ravel(), k.ravel()]))

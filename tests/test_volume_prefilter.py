@@ -79,7 +79,7 @@ def test_bad_options_say_what_to_do():
     with pytest.raises(ValueError, match="padding must be one of"):
         VolumeSpline(np.zeros((5, 5, 5)), padding="mirror")
     with pytest.raises(ValueError, match="extrapolates from 4 samples per axis.*padding='linear'"):
-        VolumeSpline(np.zeros((3, 5, 5)), "cubic", padding="cubic")
+        VolumeSpline(np.zeros((3, 5, 5)), "cubic", padding="cubic", order="zyx")
 
 
 # ---------------------------------------------------------------------------------- reproduction and interpolation
@@ -90,7 +90,7 @@ def test_prefiltered_splines_reproduce_quadratics_up_to_the_boundary(scheme, pre
     n = 9
     c = RNG.normal(size=10)
     f = _quadratic(_grid(n), c)
-    s = VolumeSpline(f, scheme, prefilter=prefilter, padding=padding)
+    s = VolumeSpline(f, scheme, prefilter=prefilter, padding=padding, order="zyx")
     p = RNG.uniform(-0.5, n - 0.5, (3000, 3))  # the whole domain, the outer half-cubes included
     v, g = s.evaluate(p, gradient=True)
     scale = np.abs(f).max()
@@ -101,7 +101,7 @@ def test_prefiltered_splines_reproduce_quadratics_up_to_the_boundary(scheme, pre
     assert np.abs(g - grad).max() < 1e-11 * scale
     # and not cubics: order 3 is the most these spaces give (the cubic scheme reproduces no cubic either)
     f3 = _grid(n)[..., 0] ** 3
-    s3 = VolumeSpline(f3, scheme, prefilter=prefilter, padding=padding)
+    s3 = VolumeSpline(f3, scheme, prefilter=prefilter, padding=padding, order="zyx")
     inner = RNG.uniform(2.0, n - 3.0, (500, 3))
     assert np.abs(s3.evaluate(inner) - inner[:, 0] ** 3).max() > 1e-3
 
@@ -110,17 +110,18 @@ def test_the_plain_schemes_shift_quadratics_and_linear_padding_breaks_them_at_th
     n = 9
     f = _grid(n)[..., 0] ** 2
     inner = RNG.uniform(2.0, n - 3.0, (500, 3))
-    s = VolumeSpline(f, "quadratic")
+    s = VolumeSpline(f, "quadratic", order="zyx")
     assert np.allclose(s.evaluate(inner), inner[:, 0] ** 2 + 0.25, atol=1e-12)  # the constant h^2 / 4
     edge = np.array([[-0.5, 4.0, 4.0]])
     assert math.isclose(float(s.evaluate(edge)[0]), -0.5, abs_tol=1e-12)  # true 0.25: the linear padding
-    assert math.isclose(float(VolumeSpline(f, "quadratic", padding="quadratic").evaluate(edge)[0]), 0.5,
+    s2 = VolumeSpline(f, "quadratic", order="zyx", padding="quadratic")
+    assert math.isclose(float(s2.evaluate(edge)[0]), 0.5,
                         abs_tol=1e-12)  # x^2 + 1/4 there too
 
 
 def test_interpolating_cubic_interpolates_the_samples_even_noisy_ones():
     f = RNG.normal(size=(10, 11, 12))  # white noise: the worst conditioned data
-    s = VolumeSpline(f, "cubic", prefilter="interpolate", padding="cubic")
+    s = VolumeSpline(f, "cubic", prefilter="interpolate", padding="cubic", order="zyx")
     z, y, x = np.mgrid[0:10, 0:11, 0:12]
     pts = np.stack([x, y, z], axis=-1).reshape(-1, 3).astype(float)
     assert np.abs(s.evaluate(pts) - f.ravel()).max() < 1e-10

@@ -5,8 +5,11 @@
 
 :func:`read_volume` accepts
 
-* a 3-D numpy array ``values[k, j, i]`` (``spacing``/``origin`` keywords, defaults ``(1, 1, 1)`` and
-  ``(0, 0, 0)``),
+* a 3-D numpy array (``spacing``/``origin`` keywords, defaults ``(1, 1, 1)`` and ``(0, 0, 0)``) in the axis
+  order ``order=`` gives: ``"xyz"`` (the default, as ``pyvista.wrap``: ``arr[i, j, k]`` is the sample at
+  ``origin + (i * dx, j * dy, k * dz)``, shape ``(nx, ny, nz)``) or ``"zyx"`` (``arr[k, j, i]``, shape
+  ``(nz, ny, nx)``: what ``np.mgrid`` unpacked as ``z, y, x`` gives, and the order of ``VolumeGrid.values``);
+  see *Axis order of numpy arrays* below,
 * a pyvista ``ImageData`` or a ``vtkImageData`` (point data; cell data see below), a uniform
   ``RectilinearGrid`` or an axis-aligned uniform ``StructuredGrid``,
 * a file:
@@ -65,6 +68,14 @@ Conventions kept by every reader
   (:mod:`.nifti`) with rotated or permuted orthogonal axes keep them in ``VolumeGrid.direction``; spacing and
   origin are in the file's units and its world frame (Bohr for cube files; NIfTI's RAS+ millimetres and the
   NRRD ``space`` are kept as given, not converted into each other).
+* **Axis order of numpy arrays.** ``order="xyz"`` is the default because ``pyvista.wrap`` reads a 3-D array that
+  way (``dimensions = arr.shape``); ``VolumeGrid.values`` stays ``[k, j, i]`` and an ``"xyz"`` array is
+  transposed on reading. The two orders read different volumes unless the array equals itself with its first
+  and last axes swapped (then the order does not matter, e.g. a sphere sampled on a cube). splinevis used to
+  read arrays as ``"zyx"`` only, so an array read without ``order=`` whose two readings differ warns,
+  once per calling line, with its shape and what each order makes of it; passing ``order=`` (either) says
+  which was meant and gives no warning. Files, pyvista grids and raw data carry their own order: ``order=``
+  applies to numpy arrays (and lists) only.
 * DICOM series, Analyze/NIfTI header-image pairs (``.hdr``/``.img``) and MINC are not read (VTK's readers
   ignore parts of their orientation); convert them to NIfTI (``.nii``), NRRD or MetaImage first.
 """
@@ -79,6 +90,7 @@ from pathlib import Path
 import numpy as np
 
 from .._validation import as_float64_array
+from .._warnings import warn_user
 from ._common import (VTK_FILES, check_geometry, fill_nearest, first_gap, freeze_grid, gap_error,
                       refuse_own_geometry, require_regular_file, source_kind, unsupported_extension)
 from .nrrd import read_nrrd
@@ -89,7 +101,11 @@ from .slices import is_glob, read_slices
 from .volume_samples import GEOMETRY_ARGS_APPLY_TO, VolumeSamples, from_array, orthonormal_direction
 from .volume_vtk import from_pyvista, metaimage_direction, read_vtk_file
 
-__all__ = ["VolumeGrid", "read_volume", "VOLUME_EXTENSIONS"]
+__all__ = ["VolumeGrid", "read_volume", "VOLUME_EXTENSIONS", "ARRAY_ORDERS"]
+
+#: Axis orders of a numpy volume (``read_volume(order=)``): ``"xyz"`` reads ``arr[i, j, k]`` (pyvista.wrap's
+#: order, the default), ``"zyx"`` reads ``arr[k, j, i]`` (``VolumeGrid.values``' order).
+ARRAY_ORDERS = ("xyz", "zyx")
 
 _RAW_EXTENSIONS = (".raw", ".bin")
 # What a volume needs of each VTK file kind (said in the error messages).
@@ -274,15 +290,19 @@ class VolumeGrid:
 # --------------------------------------------------------------------------------------------------
 # Public entry point
 # --------------------------------------------------------------------------------------------------
-def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, dtype=None, byteorder=None,
+def read_volume(source, *, order=None, scalars=None, spacing=None, origin=None, shape=None, dtype=None, byteorder=None,
                 header_bytes=0, fill=None, component=None, resample=False) -> VolumeGrid:
     """Read volume data into a :class:`VolumeGrid` (see the module notes for formats and conventions).
 
     Parameters
     ----------
-    source : (nz, ny, nx) array_like, pyvista/VTK ImageData, RectilinearGrid, StructuredGrid, str or Path
-        The samples; ``values[k, j, i]`` of a numpy array lies at ``origin + (i*dx, j*dy, k*dz)``. A str
-        or Path is a file; see ``VOLUME_EXTENSIONS``.
+    source : array_like, pyvista/VTK ImageData, RectilinearGrid, StructuredGrid, str or Path
+        The samples: a 3-D numpy array in the axis order ``order``, or a grid, or a file (a str or Path; see
+        ``VOLUME_EXTENSIONS``).
+    order : {"xyz", "zyx"}, optional
+        Numpy arrays only: ``"xyz"`` (default, as ``pyvista.wrap``): ``arr[i, j, k]``, shape ``(nx, ny, nz)``, lies
+        at ``origin + (i*dx, j*dy, k*dz)``; ``"zyx"``: ``arr[k, j, i]``, shape ``(nz, ny, nx)``. Omitted for an
+        array whose two readings differ, it warns (the default was ``"zyx"`` before; module notes).
     scalars : str, optional
         Name of the data array (pyvista/VTK sources and files with named arrays). Needed when there
         are several arrays.
@@ -329,10 +349,13 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
     Examples
     --------
     >>> import numpy as np
-    >>> g = read_volume(np.arange(24, dtype=np.uint16).reshape(2, 3, 4), spacing=(0.5, 0.5, 2.0),
+    >>> g = read_volume(np.arange(24, dtype=np.uint16).reshape(2, 3, 4), order="zyx", spacing=(0.5, 0.5, 2.0),
     ...                 origin=(1e6, 0.0, -3.0))
     >>> g.shape, g.dtype, float(g.values[1, 2, 3]), g.to_world([3, 2, 1]).tolist()
     ((2, 3, 4), 'uint16', 23.0, [1000001.5, 1.0, -1.0])
+    >>> x = read_volume(np.arange(24.0).reshape(4, 3, 2), order="xyz")  # arr[i, j, k]: nx, ny, nz = 4, 3, 2
+    >>> x.shape, x.bounds, float(x.values[1, 2, 3])  # values[k, j, i] = arr[i, j, k]
+    ((2, 3, 4), (0.0, 3.0, 0.0, 2.0, 0.0, 1.0), 23.0)
     >>> import pyvista as pv
     >>> img = pv.ImageData(dimensions=(4, 3, 2), spacing=(1.0, 2.0, 3.0))
     >>> img.point_data["density"] = np.arange(24.0)
@@ -349,6 +372,9 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
         raise ValueError(f"component {component!r} is not known; pass an int (0-based component) or 'magnitude'.")
     if not isinstance(resample, (bool, np.bool_)):
         raise TypeError(f"resample must be True or False, got {resample!r}.")
+    if order is not None and (not isinstance(order, str) or order not in ARRAY_ORDERS):
+        raise ValueError(f"order {order!r} is not known; choose 'xyz' (arr[i, j, k], as pyvista.wrap) or 'zyx' "
+                         "(arr[k, j, i]).")
     if scalars is not None and not isinstance(scalars, str):
         raise TypeError(f"scalars must be the name (str) of a data array, got {type(scalars).__name__}.")
     if spacing is not None:
@@ -367,9 +393,63 @@ def read_volume(source, *, scalars=None, spacing=None, origin=None, shape=None, 
             raise ValueError(f"{' and '.join(given)}= describe headerless raw files (.raw, .bin); "
                              f"{_describe(source)} carries that information itself. Drop the argument.")
 
+    if order is not None and source_kind(source) != "array":
+        raise ValueError(f"order= gives the axis order of a numpy array; {_describe(source)} carries its own. "
+                         "Drop the argument.")
+    if source_kind(source) == "array":
+        source = _array_in_zyx(np.asarray(source), order)
     samples = _dispatch(source, scalars=scalars, spacing=spacing, origin=origin, shape=shape, dtype=dtype,
                     byteorder=byteorder, header_bytes=header_bytes, component=component, resample=bool(resample))
     return _finish(samples, fill)
+
+
+def _array_in_zyx(arr: np.ndarray, order) -> np.ndarray:
+    """``arr`` given in axis ``order`` as ``[k, j, i]`` (components, if any, stay last); ``order=None`` reads
+    ``"xyz"`` and warns when the two readings differ (module notes). Other ranks are left to the checks."""
+    if arr.ndim not in (3, 4) or arr.dtype.kind not in "biuf":
+        return arr  # the checks say what is wrong (rank, strings, complex numbers)
+    if order is None:
+        if not _same_in_both_orders(arr):
+            warn_user(_order_warning(arr.shape))
+        order = "xyz"
+    return np.ascontiguousarray(arr.swapaxes(0, 2)) if order == "xyz" else arr
+
+
+def _same_in_both_orders(arr: np.ndarray) -> bool:
+    """True when ``arr`` equals itself with axes 0 and 2 swapped, to rounding (both orders read the same volume);
+    compared slab by slab, stopping at the first difference.
+
+    Floating-point samples count as equal within ``8 eps max|arr|``: a field symmetric in x and z evaluated on a
+    cube, such as ``x**2 + y**2 + z**2``, sums the same terms in another order at the swapped sample; a sum of
+    three terms rounds twice, each time by at most ``eps/2`` of a partial sum, so the two orders differ by at
+    most ``2 eps`` times the sum of the terms' magnitudes (the value itself for nonnegative terms). A field
+    whose terms cancel more than that warns: the safe side. Integers and booleans must be equal.
+
+    >>> z, y, x = np.mgrid[-1:1:5j, -1:1:5j, -1:1:5j]
+    >>> _same_in_both_orders(x**2 + y**2 + z**2), _same_in_both_orders(x + 2 * z), _same_in_both_orders(x + 2 * y)
+    (True, False, False)
+    """
+    if arr.shape[0] != arr.shape[2]:
+        return False
+    swapped = arr.swapaxes(0, 2)
+    if arr.dtype.kind == "f":
+        tol = 8 * np.finfo(arr.dtype).eps * float(np.max(np.abs(arr)))
+        return all(np.all(np.abs(arr[s] - swapped[s]) <= tol) for s in range(arr.shape[0]))
+    return all(np.array_equal(arr[s], swapped[s]) for s in range(arr.shape[0]))
+
+
+def _order_warning(shape) -> str:
+    """What each axis order makes of a numpy array of ``shape`` read without ``order=``.
+
+    >>> print(_order_warning((4, 3, 2)))
+    read_volume: a numpy array of shape (4, 3, 2) read without order=, as order='xyz' (arr[i, j, k], as pyvista.wrap): nx, ny, nz = 4, 3, 2; order='zyx' (arr[k, j, i], splinevis's former default) reads nx, ny, nz = 2, 3, 4. Pass order='xyz' or order='zyx' to say which (no warning then).
+    """
+    a, b, c = shape[:3]
+    other = (f"reads nx, ny, nz = {c}, {b}, {a}" if a != c else
+             "reads the same nx, ny, nz, but x and z swapped (a different volume)")
+    return (f"read_volume: a numpy array of shape {tuple(shape)} read without order=, as order='xyz' (arr[i, j, k], "
+            f"as pyvista.wrap): nx, ny, nz = {a}, {b}, {c}; order='zyx' (arr[k, j, i], splinevis's former "
+            f"default) {other}. Pass order='xyz' or order='zyx' to say which (no warning then).")
 
 
 def _describe(source) -> str:
@@ -377,7 +457,8 @@ def _describe(source) -> str:
         return str(source)
     if isinstance(source, np.ndarray):
         return "a numpy array"
-    return f"a {type(source).__name__}"
+    name = type(source).__name__
+    return f"{'an' if name[:1] in 'AEIOU' else 'a'} {name}"
 
 
 def _dispatch(source, *, scalars, spacing, origin, shape, dtype, byteorder, header_bytes, component,

@@ -96,7 +96,7 @@ def padded_volume_dask(samples, *, chunks=64, scheme="quadratic", prefilter="non
     >>> bool((padded_volume_dask(v, chunks=3).compute() == pad_volume(v)).all())
     True
     >>> P = padded_volume_dask(v, chunks=3, scheme="cubic", prefilter="local", padding="quadratic").compute()
-    >>> bool((P == VolumeSpline(v, "cubic", prefilter="local", padding="quadratic").padded).all())
+    >>> bool((P == VolumeSpline(v, "cubic", prefilter="local", padding="quadratic", order="zyx").padded).all())
     True
     """
     from ..volume.prefilter import centre_kernel, check_prefilter
@@ -242,7 +242,7 @@ def volume_cube_ranges_dask(samples, scheme="quadratic", *, chunks=64):
     >>> from splinevis.volume.model import VolumeSpline
     >>> v = np.random.default_rng(4).random((6, 7, 8))
     >>> r = volume_cube_ranges_dask(v, "cubic", chunks=3).compute()
-    >>> lo, hi = VolumeSpline(v, "cubic").cube_ranges()
+    >>> lo, hi = VolumeSpline(v, "cubic", order="zyx").cube_ranges()
     >>> r.dtype, bool((r[..., 0] == lo).all() and (r[..., 1] == hi).all())
     (dtype('float32'), True)
     """

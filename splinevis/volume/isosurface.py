@@ -56,7 +56,7 @@ class Isosurface:
         """``(xmin, xmax, ymin, ymax)`` of the spline's domain: what a draped texture spans
         (``Style.texture_extent`` is relative to it).
 
-        >>> surface = Isosurface(VolumeSpline(np.zeros((4, 4, 4)), spacing=(0.5, 1.0, 1.0)), 0.0)
+        >>> surface = Isosurface(VolumeSpline(np.zeros((4, 4, 4)), spacing=(0.5, 1.0, 1.0), order="zyx"), 0.0)
         >>> surface.extent
         (-0.25, 1.75, -0.5, 3.5)
         """
@@ -69,7 +69,7 @@ def value_reference(spline: VolumeSpline) -> float:
 
     Examples
     --------
-    >>> value_reference(VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0))
+    >>> value_reference(VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0, order="zyx"))
     1013.0
     """
     lo, hi = spline.value_range

@@ -60,7 +60,7 @@ def coefficient_range(spline, *, chunk: int = 4096) -> tuple:
 
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-    >>> coefficient_range(VolumeSpline(x, "quadratic"))  # linear data, linear padding: exactly x over the domain
+    >>> coefficient_range(VolumeSpline(x, "quadratic", order="zyx"))  # linear data and padding: x over the domain
     (-0.5, 5.5)
     """
     cached = getattr(spline, "_coefficient_range", None)
@@ -86,7 +86,7 @@ def vertex_value_range(spline, relevant, *, stop_at: float | None = None, chunk:
 
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-    >>> s = VolumeSpline(x, "quadratic")
+    >>> s = VolumeSpline(x, "quadratic", order="zyx")
     >>> vertex_value_range(s, s.relevant(2.25))  # x = 2.25 lies in the cube of sample 2: x in [1.5, 2.5]
     (1.5, 2.5)
     """

@@ -69,7 +69,7 @@ class Relevant:
     Examples
     --------
     >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-    >>> rel = VolumeSpline(x, "quadratic").relevant(2.5)  # the plane x = 2.5 between two slabs of cubes
+    >>> rel = VolumeSpline(x, "quadratic", order="zyx").relevant(2.5)  # the plane x = 2.5 between two slabs of cubes
     >>> sorted(set(rel.cubes[:, 0].tolist())), len(rel.cubes), rel.candidates
     ([2, 3], 72, 72)
     """
@@ -95,8 +95,9 @@ class VolumeSpline:
 
     Parameters
     ----------
-    volume : VolumeGrid, or array-like (nz, ny, nx), or anything :func:`splinevis.io.volumes.read_volume`
-        accepts (a file path, a pyvista ImageData, ...).
+    volume : VolumeGrid, or anything :func:`splinevis.io.volumes.read_volume` accepts (a 3-D array, in the axis
+        order ``order=``: ``"xyz"``, ``arr[i, j, k]`` as ``pyvista.wrap``, by default, or ``"zyx"``; a file path, a
+        pyvista ImageData, ...).
     scheme : {"quadratic", "cubic"}
         ``"quadratic"``: quadratic super spline; ``"cubic"``: cubic C1 quasi-interpolant
         (docs/volume-schemes.md).
@@ -109,18 +110,18 @@ class VolumeSpline:
         (:data:`splinevis.volume.stencil.PADDINGS`); ``"linear"`` is the paper's, the others keep order 2
         for gradients up to the boundary.
     **read_options
-        Passed to ``read_volume`` (spacing, origin, scalars, ...).
+        Passed to ``read_volume`` (order, spacing, origin, scalars, ...).
 
     Examples
     --------
     >>> import numpy as np
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
-    >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic")
+    >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic", order="zyx")
     >>> float(s.evaluate([[3.25, 2.5, 1.0]])[0])  # linear data are reproduced
     11.25
-    >>> q = VolumeSpline(x ** 2, "quadratic", prefilter="local", padding="quadratic")  # x^2 exact, boundary too
-    >>> float(q.evaluate([[-0.5, 0.0, 0.0]])[0]), float(VolumeSpline(x ** 2).evaluate([[-0.5, 0.0, 0.0]])[0])
+    >>> q = VolumeSpline(x ** 2, "quadratic", order="zyx", prefilter="local", padding="quadratic")  # x^2 exact
+    >>> float(q.evaluate([[-0.5, 0.0, 0.0]])[0]), float(VolumeSpline(x ** 2, order="zyx").evaluate([[-0.5, 0, 0]])[0])
     (0.25, -0.5)
     """
 
@@ -160,7 +161,7 @@ class VolumeSpline:
         kept as given: a window of a larger volume pads with the neighbouring samples, not extrapolation).
 
         >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-        >>> full = VolumeSpline(x * y + z)
+        >>> full = VolumeSpline(x * y + z, order="zyx")
         >>> w = VolumeSpline.from_padded(full.padded[2:7, 1:6, 0:5], origin=(0.0, 1.0, 2.0))  # cubes z 2..4, y 1..3
         >>> w.shape, bool((w.cube_coefficients([[1, 1, 1]]) == full.cube_coefficients([[1, 2, 3]])).all())
         ((3, 3, 3), True)
@@ -190,7 +191,7 @@ class VolumeSpline:
     def shape(self) -> tuple:
         """``(nz, ny, nx)`` cubes (= data points).
 
-        >>> s = VolumeSpline(np.zeros((3, 4, 5)))
+        >>> s = VolumeSpline(np.zeros((3, 4, 5)), order="zyx")
         >>> s.shape, s.padded.shape  # the padded data add a layer on every side
         ((3, 4, 5), (5, 6, 7))
         """
@@ -200,7 +201,7 @@ class VolumeSpline:
     def spacing(self) -> np.ndarray:
         """``(dx, dy, dz)`` of the data, float64 (world units per cube).
 
-        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 0.5, 2.0)).spacing
+        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 0.5, 2.0), order="zyx").spacing
         array([0.5, 0.5, 2. ])
         """
         return np.asarray(self.grid.spacing, dtype=np.float64)
@@ -209,7 +210,7 @@ class VolumeSpline:
     def origin(self) -> np.ndarray:
         """World position of data point (0, 0, 0), the centre of the first cube, float64.
 
-        >>> VolumeSpline(np.zeros((3, 4, 5)), origin=(5e5, 0.0, -10.0)).origin
+        >>> VolumeSpline(np.zeros((3, 4, 5)), origin=(5e5, 0.0, -10.0), order="zyx").origin
         array([ 5.e+05,  0.e+00, -1.e+01])
         """
         return np.asarray(self.grid.origin, dtype=np.float64)
@@ -218,7 +219,7 @@ class VolumeSpline:
     def bounds(self) -> tuple:
         """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the spline's domain (cube faces, world).
 
-        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 1.0, 2.0)).bounds  # half a cube beyond the data
+        >>> VolumeSpline(np.zeros((3, 4, 5)), spacing=(0.5, 1.0, 2.0), order="zyx").bounds  # half a cube beyond the data
         (-0.25, 2.25, -0.5, 3.5, -1.0, 5.0)
         """
         n = np.array(self.shape[::-1], dtype=np.float64)
@@ -230,7 +231,7 @@ class VolumeSpline:
     def value_range(self) -> tuple:
         """``(min, max)`` of the data.
 
-        >>> VolumeSpline(np.arange(27.0).reshape(3, 3, 3)).value_range
+        >>> VolumeSpline(np.arange(27.0).reshape(3, 3, 3), order="zyx").value_range
         (0.0, 26.0)
         """
         return self.grid.value_range
@@ -242,7 +243,8 @@ class VolumeSpline:
         exceed :attr:`value_range`).
 
         >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
-        >>> VolumeSpline(x).value_range, VolumeSpline(x).data_range  # the padding extrapolates to -1 and 4
+        >>> s = VolumeSpline(x, order="zyx")
+        >>> s.value_range, s.data_range  # the padding extrapolates to -1 and 4
         ((0.0, 3.0), (-1.0, 4.0))
         """
         r = getattr(self, "_data_range", None)
@@ -257,7 +259,7 @@ class VolumeSpline:
         Examples
         --------
         >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
-        >>> s = VolumeSpline(x)
+        >>> s = VolumeSpline(x, order="zyx")
         >>> s.stencil_data([[1, 1, 1], [0, 0, 0]])[:, :3]  # x - 1, x, x + 1; the padding extrapolates linearly
         array([[ 0.,  1.,  2.],
                [-1.,  0.,  1.]])
@@ -275,7 +277,7 @@ class VolumeSpline:
         Examples
         --------
         >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
-        >>> c = VolumeSpline(x + 2 * y + 3 * z, "cubic").cube_coefficients([[1, 2, 3]])
+        >>> c = VolumeSpline(x + 2 * y + 3 * z, "cubic", order="zyx").cube_coefficients([[1, 2, 3]])
         >>> c.shape, round(float(c[0, 0, 0]), 9)  # coefficient 0 of every tetrahedron: the cube centre (1, 2, 3)
         ((1, 24, 20), 14.0)
         """
@@ -307,7 +309,8 @@ class VolumeSpline:
         Examples
         --------
         >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
-        >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic", spacing=(0.5, 0.5, 1.0), origin=(10.0, 0.0, 0.0))
+        >>> s = VolumeSpline(x + 2 * y + 3 * z, "quadratic", order="zyx", spacing=(0.5, 0.5, 1.0),
+        ...                  origin=(10.0, 0.0, 0.0))
         >>> s.evaluate([[11.25, 1.0, 2.5]], gradient=True)  # index (2.5, 2, 2.5); gradient per world unit
         (array([14.]), array([[2., 4., 3.]]))
         """
@@ -333,7 +336,7 @@ class VolumeSpline:
         The level sets of |x|^2 are spheres; both schemes reproduce its Hessian:
 
         >>> z, y, x = np.mgrid[-1:1:11j, -1:1:11j, -1:1:11j]
-        >>> s = VolumeSpline(x ** 2 + y ** 2 + z ** 2, "cubic", spacing=(0.2,) * 3, origin=(-1.0,) * 3)
+        >>> s = VolumeSpline(x ** 2 + y ** 2 + z ** 2, "cubic", spacing=(0.2,) * 3, origin=(-1.0,) * 3, order="zyx")
         >>> s.curvature([[0.5, 0.0, 0.0], [0.0, 0.3, 0.4]]).round(9)  # r = 0.5: mean 2, Gaussian 4
         array([[2., 4.],
                [2., 4.]])
@@ -371,7 +374,7 @@ class VolumeSpline:
         Examples
         --------
         >>> z, y, x = np.mgrid[0:4, 0:4, 0:4].astype(float)
-        >>> lo, hi = VolumeSpline(x).cube_ranges()
+        >>> lo, hi = VolumeSpline(x, order="zyx").cube_ranges()
         >>> lo.shape, lo.dtype, float(lo[1, 1, 1]), float(hi[1, 1, 1])  # data 0..2, one float32 step outward
         ((4, 4, 4), dtype('float32'), -1.401298464324817e-45, 2.000000238418579)
         """
@@ -401,7 +404,7 @@ class VolumeSpline:
         """The min-max octree (built on first use; independent of the isovalue).
 
         >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(float)
-        >>> octree = VolumeSpline(x).octree
+        >>> octree = VolumeSpline(x, order="zyx").octree
         >>> octree.depth, octree.nodes(2.5, 1).shape  # blocks of 2^3 cubes that can hold x = 2.5
         (3, (16, 3))
         """
@@ -417,7 +420,7 @@ class VolumeSpline:
         Examples
         --------
         >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-        >>> s = VolumeSpline(x, "quadratic")
+        >>> s = VolumeSpline(x, "quadratic", order="zyx")
         >>> rel = s.relevant(2.5)
         >>> len(rel.cubes), rel.num_tets, len(s.relevant(100.0).cubes)
         (72, 1152, 0)

@@ -48,7 +48,7 @@ def hessian_bounds(spline, cubes, *, chunk: int = 8192) -> np.ndarray:
     --------
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:5, 0:5, 0:5] * 0.5
-    >>> s = VolumeSpline(x * x + 3 * y * z, "cubic", spacing=(0.5,) * 3)  # Hessian [[2, 0, 0], [0, 0, 3], [0, 3, 0]]
+    >>> s = VolumeSpline(x * x + 3 * y * z, "cubic", order="zyx", spacing=(0.5,) * 3)  # Hessian [[2,0,0],[0,0,3],[0,3,0]]
     >>> hessian_bounds(s, [[2, 2, 2]]).round(9)  # Gershgorin: max(2, 3, 3)
     array([3.])
     """
@@ -74,7 +74,7 @@ def distance_estimates(spline, cubes, k: int, gradient_min: float) -> np.ndarray
 
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:5, 0:5, 0:5].astype(float)
-    >>> s = VolumeSpline(x * x, "quadratic")  # s_xx = 2; fine cells of side 1/2: delta = 2 (1/32 + 3/8)
+    >>> s = VolumeSpline(x * x, "quadratic", order="zyx")  # s_xx = 2; fine cells of side 1/2: delta = 2 (1/32 + 3/8)
     >>> distance_estimates(s, [[2, 2, 2]], 2, 4.0).round(9)  # at |grad s| >= 4
     array([0.203125])
     """
@@ -104,7 +104,7 @@ def fine_points(spline, k: int) -> int:
     """Number of fine grid points of :func:`sample_spline` at ``k`` samples per cube and axis.
 
     >>> from splinevis.volume.model import VolumeSpline
-    >>> fine_points(VolumeSpline(np.zeros((3, 4, 5))), 2)
+    >>> fine_points(VolumeSpline(np.zeros((3, 4, 5)), order="zyx"), 2)
     693
     """
     return int(np.prod([n * int(k) + 1 for n in spline.shape]))
@@ -116,7 +116,7 @@ def sample_spline(spline, isovalue: float, k: int, relevant=None):
 
     >>> from splinevis.volume.model import VolumeSpline
     >>> z, y, x = np.mgrid[0:6, 0:6, 0:6].astype(float)
-    >>> g = sample_spline(VolumeSpline(x, "quadratic"), 2.25, 2)  # linear data are reproduced
+    >>> g = sample_spline(VolumeSpline(x, "quadratic", order="zyx"), 2.25, 2)  # linear data are reproduced
     >>> g.shape, g.spacing, g.values[0, 0, 4:8].tolist()  # x = 1.5, 2, 2.5 (cube 2, exact); x = 3: filled
     ((13, 13, 13), (0.5, 0.5, 0.5), [1.5, 2.0, 2.5, 7.25])
     """

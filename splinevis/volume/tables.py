@@ -28,7 +28,7 @@ def data_texture(spline: VolumeSpline) -> np.ndarray:
 
     Examples
     --------
-    >>> spline = VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0)  # 1000 + x + 3 y + 9 z
+    >>> spline = VolumeSpline(np.arange(27.0).reshape(3, 3, 3) + 1000.0, order="zyx")  # 1000 + x + 3 y + 9 z
     >>> table = data_texture(spline)  # 5^3 padded values minus 1013, four per texel
     >>> table.shape, table.dtype, table[0, 0]  # from the padded corner (-1, -1, -1): 987 - 1013
     ((1, 8192, 4), dtype('float32'), array([-26., -25., -24., -23.], dtype=float32))
