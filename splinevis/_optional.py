@@ -1,13 +1,14 @@
 """What a missing optional dependency means for the user: the ``pip install`` that brings it.
 
-splinevis's core (numpy, scipy, VTK, PyVista, moderngl, scikit-image, matplotlib, tqdm, Pillow, nibabel) draws
-terrains from arrays and VTK files, volumes, NURBS given as arrays and geometry images of given control grids.
-Readers and builders that need more import it where they use it, from an extra: ``[geo]`` (rasterio/GDAL),
-``[cad]`` (rhino3dm, pyiges, shapely, PythonCDT, OpenCASCADE), ``[mesh]`` (libigl, pymeshlab), ``[dask]``
-(dask, distributed, zarr); ``[all]`` is all of them. A finder placed last on ``sys.meta_path`` is asked only
-when no other finder found a module; for the extras' modules it raises ``ModuleNotFoundError`` naming the extra
-and the command, instead of Python's bare "No module named 'rasterio'". Code that probes for a module with
-``try: import ... except ImportError`` still works: the error is an ``ImportError``.
+splinevis's core (numpy, scipy, VTK, PyVista, moderngl, scikit-image, matplotlib, tqdm, Pillow) draws terrains
+from arrays and VTK files, volumes from arrays and VTK, NRRD, MetaImage, cube and raw files, NURBS given as arrays
+and geometry images of given control grids. Readers and builders that need more import it where they use it, from
+an extra: ``[nifti]`` (nibabel), ``[geo]`` (rasterio/GDAL), ``[cad]`` (rhino3dm, pyiges, shapely, PythonCDT,
+OpenCASCADE), ``[mesh]`` (libigl, pymeshlab), ``[dask]`` (dask, distributed, zarr); ``[all]`` is all of them.
+A finder placed last on ``sys.meta_path`` is asked only when no other finder found a module; for the extras'
+modules it raises ``ModuleNotFoundError`` naming the extra and the command, instead of Python's bare "No module
+named 'rasterio'". Code that probes for a module with ``try: import ... except ImportError`` still works: the
+error is an ``ImportError``.
 
 Why our own code: the import system's documented extension point (a meta-path finder) is the one place that sees
 every import of those modules, without a wrapper at each of the ~150 import sites.
@@ -21,6 +22,7 @@ __all__ = ["EXTRAS", "MissingExtraFinder", "install"]
 
 #: top-level module -> (extra, what needs it)
 EXTRAS = {
+    "nibabel": ("nifti", "NIfTI volumes (.nii, .nii.gz)"),
     "rasterio": ("geo", "GeoTIFF, SRTM and other GDAL rasters, and reprojection of geographic grids"),
     "rhino3dm": ("cad", "Rhino .3dm files"),
     "pyiges": ("cad", "IGES files"),

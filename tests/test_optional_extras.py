@@ -29,4 +29,5 @@ def test_every_extra_module_is_in_pyproject():
         "optional-dependencies"]
     for extra in {e for e, _ in _optional.EXTRAS.values()}:
         assert extra in extras and extras[extra], extra
-    assert extras["all"] == ["splinevis[geo,cad,mesh,dask]"]  # every extra, by name
+    assert extras["all"] == ["splinevis[nifti,geo,cad,mesh,dask]"]  # every extra, by name
+    assert set(extras) == {"test", "all", "nifti", "geo", "cad", "mesh", "dask"}

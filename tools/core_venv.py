@@ -7,10 +7,12 @@ What a user gets from ``pip install splinevis`` (no extras), built without the n
    --no-index`` builds the wheel there with the setuptools of the running environment;
 2. ``python -m venv --without-pip`` makes the environment (no system site-packages);
 3. the core dependencies come from the running environment without copying or downloading them: the
-   requirements of the installed splinevis that carry no marker, and recursively theirs (markers evaluated
-   with no extra), are resolved to their distributions; each top-level entry of their files (package folder,
-   module, ``.libs`` folder, ``.dist-info``) is symlinked into one folder, which a ``.pth`` file puts on the new
-   environment's path. Nothing else of the running environment is visible there: the extras' modules are not;
+   ``dependencies`` of ``pyproject.toml`` (what the wheel declares; the metadata of the editable install is only
+   as new as its last ``pip install``), and recursively the requirements of their installed distributions
+   (markers evaluated with no extra), are resolved to their distributions; each top-level entry of their files
+   (package folder, module, ``.libs`` folder, ``.dist-info``) is symlinked into one folder, which a ``.pth`` file
+   puts on the new environment's path. Nothing else of the running environment is visible there: the extras'
+   modules are not;
 4. the wheel goes in with ``pip --python <new python> install --no-deps --no-index``.
 
 Used by ``tests/test_wheel_core_install.py`` and ``benchmarks/bench_import.py``.
@@ -53,7 +55,8 @@ def build_wheel(out: Path) -> Path:
 
 def core_distributions() -> dict:
     """Name -> installed distribution of the core dependencies of splinevis and everything they need."""
-    todo = [r for r in map(Requirement, metadata.requires("splinevis") or []) if r.marker is None]
+    core = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    todo = [r for r in map(Requirement, core) if r.marker is None or r.marker.evaluate({"extra": ""})]
     found = {}
     while todo:
         req = todo.pop()

@@ -46,6 +46,9 @@ Dimensions: 3-D files, and 4-D or 5-D files whose extra axes have one sample, re
 nc)`` holds ``nc`` values per voxel (a vector field, the NIfTI convention for per-voxel components):
 ``component=`` picks one or takes the ``"magnitude"``.
 
+nibabel is the ``[nifti]`` extra (``pip install 'splinevis[nifti]'``), imported only when a NIfTI file is read;
+without it reading one raises ModuleNotFoundError naming the file and that command.
+
 Why nibabel: it is the library the neuroimaging field keeps for NIfTI (both versions, both byte orders,
 gzip, qform quaternions); VTK's ``vtkNIFTIImageReader`` (what ``pyvista.read`` uses) returns the lattice at
 origin 0 with the voxel sizes and leaves the sform and qform aside as separate matrices.
@@ -102,7 +105,12 @@ def nifti_affine(header) -> tuple:
 
 
 def _load(path: Path):
-    import nibabel as nib
+    try:  # here only: nibabel is the [nifti] extra, and no other reader needs it
+        import nibabel as nib
+    except ModuleNotFoundError as exc:  # the advice of splinevis._optional, with the file it was needed for
+        if exc.name != "nibabel":
+            raise
+        raise ModuleNotFoundError(f"{path}: {exc}", name=exc.name) from None
 
     try:
         img = nib.load(str(path))
