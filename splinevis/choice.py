@@ -55,6 +55,7 @@ import numpy as np
 
 from .gl.error_bounds import U32, depth_error
 from .gl.screen_error import SNAP_PX, View
+from .plotting_options import split_read_options
 
 __all__ = ["Renderer", "Option", "Choice", "RENDERERS", "TRIANGLE_CAP", "choose", "check_max_error",
            "add_by_accuracy", "raycast_error_px"]
@@ -454,7 +455,9 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
 
     The view is the plotter's camera if it was set, else pyvista's default view fitted to the model's bounds
     (what the first render would show); the camera is then set to that view (moving it closer afterwards
-    can break the request: call again or choose for the final camera). The actor gets ``renderer_choice`` (a
+    can break the request: call again or choose for the final camera). The reader's keywords (``order``,
+    ``spacing``, ``origin``) may be in ``options`` as in ``read_options``
+    (:func:`splinevis.plotting_options.split_read_options`). The actor gets ``renderer_choice`` (a
     :class:`Choice`); the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
 
     Examples
@@ -473,11 +476,11 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
     from .programs import get
 
     max_error_px = check_max_error(max_error_px)
-    options = dict(options)
+    read_options, options = split_read_options(program, read_options, options)
     spline_options = {k: options.pop(k) for k in ("name", "newton_iterations", "program_options", "program")
                       if k in options}
     st = style_from(style, options)
-    model = get(program).model_from(*args, **(read_options or {}))
+    model = get(program).model_from(*args, **read_options)
     ren = plotter.renderer
     if not ren.camera_set:  # pyvista's view at the first render: the theme's direction, fitted to the bounds
         b = list(_model_bounds(model))

@@ -12,7 +12,7 @@ import numpy as np
 
 from .effects import Style
 from .gl import headless
-from .plotting_options import READ_KEYWORDS, _anti_aliasing_choice, _check_window_size, _style_from
+from .plotting_options import _anti_aliasing_choice, _check_window_size, _style_from, split_read_options
 
 headless.configure()
 
@@ -259,8 +259,10 @@ class Plotter(pv.Plotter):
 
         ``heights`` is anything :func:`splinevis.io.read_heights` reads (2-D array, pyvista grid, VTK
         file, USGS DEM, GeoTIFF) or a :class:`~splinevis.io.HeightGrid`; ``scheme`` one of
-        ``linear, C0, C1, C2, C2-cubic``. Returns the :class:`SplineActor`; its ``model`` attribute is
-        the :class:`~splinevis.terrain.TerrainSpline`.
+        ``linear, C0, C1, C2, C2-cubic``. ``spacing=`` and ``origin=`` go to the reader given plainly (as
+        ``pv.wrap`` takes them) or in ``read_options``, with or without ``max_error_px``; ``order=`` is a
+        volume's and raises TypeError saying the array's one reading (``heights[j, i]``, rows along y). Returns
+        the :class:`SplineActor`; its ``model`` attribute is the :class:`~splinevis.terrain.TerrainSpline`.
 
         Examples
         --------
@@ -272,6 +274,7 @@ class Plotter(pv.Plotter):
         >>> actor.model.num_patches
         2048
         """
+        read_options, options = split_read_options("terrain", read_options, options)
         if max_error_px is not None:
             from .choice import add_by_accuracy
 
@@ -341,8 +344,9 @@ class Plotter(pv.Plotter):
         to the boundary) choose the spline (:class:`~splinevis.volume.VolumeSpline`; all ignored for a
         VolumeSpline). ``culling``: hierarchical
         view-frustum culling of the proxies by the octree before every frame (``actor.culler``). Program options
-        (``encoding``, ``roots``) go in ``program_options``; other keywords are effects (see
-        :meth:`add_spline`). An isovalue outside the data's range (an empty isosurface) raises ValueError
+        (``encoding``, ``roots``) go in ``program_options``; ``order``, ``spacing`` and ``origin`` go to the
+        reader, given plainly or in ``read_options``, with or without ``max_error_px``; other keywords are
+        effects (see :meth:`add_spline`). An isovalue outside the data's range (an empty isosurface) raises ValueError
         giving the range. A volume on a rotated orthogonal lattice (``VolumeGrid.direction``, e.g. a Gaussian
         cube file) is drawn in its true frame (the actor's user matrix; culled in its lattice frame). Returns the
         :class:`SplineActor`; its ``model`` is the :class:`~splinevis.volume.isosurface.Isosurface`.
@@ -357,6 +361,7 @@ class Plotter(pv.Plotter):
         >>> len(actor.model.relevant.cubes) > 0
         True
         """
+        read_options, options = split_read_options("isosurface", read_options, options)
         if max_error_px is not None:
             from .choice import add_by_accuracy
 
@@ -371,13 +376,7 @@ class Plotter(pv.Plotter):
         from .programs import get
 
         program = get(program_name)
-        read_options = dict(read_options or {})
-        for key in READ_KEYWORDS:  # PyVista users pass an array's spacing and origin with it, as pv.wrap would
-            if key in options:
-                if key in read_options:
-                    raise TypeError(f"{key} given twice: as a keyword and in read_options.")
-                read_options[key] = options.pop(key)
-        actor = self.add_spline(program.model_from(*args, **read_options), style, **options)
+        actor = self.add_spline(program.model_from(*args, **(read_options or {})), style, **options)
         if program.on_add is not None:
             program.on_add(actor, self, **(add_options or {}))
         return actor

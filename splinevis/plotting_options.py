@@ -1,7 +1,7 @@
 """The keyword arguments of :class:`splinevis.Plotter` and its ``add_*`` methods, checked and translated before
 anything is drawn: style options into a :class:`~splinevis.Style` (PyVista's names ``cmap`` and ``clim``
 taken, its ``smooth_shading`` and the like refused with the reason), ``anti_aliasing``, ``window_size``, and the
-reader's keywords (``spacing``, ``origin``) passed with an array."""
+reader's keywords (``spacing``, ``origin``, a volume's ``order``) passed with an array."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 
 from .effects import Style
 
-__all__ = ["READ_KEYWORDS", "PYVISTA_ALIASES", "PYVISTA_REFUSED"]
+__all__ = ["READ_KEYWORDS", "PYVISTA_ALIASES", "PYVISTA_REFUSED", "split_read_options"]
 
 
 #: Keywords of ``add_terrain`` / ``add_isosurface`` that go to the reader: a numpy array's lattice and (a volume's)
@@ -27,6 +27,38 @@ PYVISTA_REFUSED = {
     "scalars": "a spline is coloured by its own scalar (a terrain's height, a volume's value): colormap='viridis' "
                "shows it; other fields are not drawn on splines yet",
 }
+
+
+#: Why a terrain refuses ``order=``: a height array has one reading (:func:`splinevis.io.read_heights`).
+_TERRAIN_ORDER = ("order= applies to volumes: add_isosurface and read_volume read a numpy volume as arr[i, j, k] "
+                  "('xyz', as pyvista.wrap) or arr[k, j, i] ('zyx'). A height array has one reading: heights[j, i] "
+                  "is the height at (x0 + i*dx, y0 + j*dy), rows along y (south to north), columns along x "
+                  "(splinevis.io.read_heights); give an array indexed [x, y] as its transpose, heights.T. Drop "
+                  "order=.")
+
+
+def split_read_options(program: str, read_options, options) -> tuple:
+    """``(read_options, other options)`` of ``Plotter.add_terrain`` / ``add_isosurface`` (``program``
+    ``"terrain"`` or ``"isosurface"``): the reader's keywords of :data:`READ_KEYWORDS` given plainly, as PyVista
+    users pass an array's spacing with it (``pv.wrap``), join ``read_options``. Done before the renderer is
+    chosen, so a call reads the same data with or without ``max_error_px``. A keyword given both ways, or
+    ``order=`` for a terrain, raises TypeError.
+
+    >>> split_read_options("isosurface", None, {"order": "zyx", "spacing": (1, 1, 2), "colormap": "viridis"})
+    ({'spacing': (1, 1, 2), 'order': 'zyx'}, {'colormap': 'viridis'})
+    >>> split_read_options("terrain", {"spacing": 1.0}, {"spacing": 2.0})
+    Traceback (most recent call last):
+    TypeError: spacing given twice: as a keyword and in read_options.
+    """
+    read_options, options = dict(read_options or {}), dict(options)
+    for key in READ_KEYWORDS:
+        if key in options:
+            if key in read_options:
+                raise TypeError(f"{key} given twice: as a keyword and in read_options.")
+            read_options[key] = options.pop(key)
+    if program == "terrain" and "order" in read_options:
+        raise TypeError(_TERRAIN_ORDER)
+    return read_options, options
 
 
 def _style_from(style, style_kwargs) -> Style:
