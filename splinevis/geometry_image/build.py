@@ -4,7 +4,8 @@
 2. **parametrize** it on the unit sphere (:func:`.sphere.spherical_parametrization`), bijectively;
 3. **sample** it on the octahedral grid, ``oversample`` times finer than the image: each grid point's direction
    (:func:`.image.octahedral_to_sphere`) is located in the spherical triangulation and mapped back to the mesh
-   (:func:`.sphere.surface_points`);
+   (:func:`.sphere.surface_points`), then moved along the mesh so that the grid is a smooth function of the
+   image coordinates (:mod:`.regularize`; the spherical map's kinks at mesh edges made the fit ripple);
 4. **fit** the bicubic control image with fairness (:func:`.fit.fit_geometry_image`);
 5. **measure** the fitted surface against the mesh, both ways, in units of the mesh's bounding-box diagonal
    (:func:`.measure.surface_distance` on the limit points ``levels_finer`` subdivision levels down).
@@ -23,6 +24,7 @@ import numpy as np
 from .fit import fit_geometry_image
 from .measure import surface_distance
 from .model import GeometryImage
+from .regularize import SIGMA_CELLS, smooth_samples, smoothing_steps
 
 __all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "fold_counts",
            "FOLDED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF", "auto_oversample"]
@@ -243,7 +245,8 @@ def _fold_measure(image, n: int) -> dict:
 
 def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="auto",
                              name: str = "mesh", measure: bool = True, levels_finer: int = 2, progress: bool = False,
-                             parametrization_options: dict | None = None, orientation="auto", sphere_map=None):
+                             parametrization_options: dict | None = None, orientation="auto", sphere_map=None,
+                             smoothing: float = SIGMA_CELLS):
     """Build an ``n x n`` smooth geometry image of the closed genus-0 ``mesh`` (module docstring).
 
     Parameters
@@ -277,6 +280,10 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     sphere_map : SphericalMap, optional
         This mesh's spherical parametrization, already made (:func:`.sphere.spherical_parametrization`): it is
         used instead of parametrizing again (its stage times are then not in the report).
+    smoothing : float
+        Width, in control cells, over which the samples are moved along the mesh before the fit so that the
+        parametrization the fit sees is smooth (:mod:`.regularize`: it removed 97 % of the folds of a real
+        scan); 0 samples the spherical map as it is.
     orientation : "auto", None or (3, 3) array
         The rotation of the sphere under the octahedron: ``"auto"`` picks the one that samples the most compressed
         part of the mesh best (:func:`.orient.best_orientation`), None keeps the parametrization's own.
@@ -300,7 +307,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     import pyvista as pv
 
     from .repair import prepare_mesh
-    from .sphere import spherical_parametrization, surface_points
+    from .sphere import locate, spherical_parametrization
     from .validate import check_genus0
 
     if not isinstance(mesh, pv.DataSet):
@@ -358,8 +365,14 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         k = auto_oversample(n, info["vertices"]) if isinstance(oversample, str) and oversample == "auto" else oversample
         M = int(k) * (int(n) - 1) + 1
         # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
-        samples = surface_points(smap, mat(octahedral_to_sphere(image_uv(M)).reshape(-1, 3), R)).reshape(M, M, 3)
+        face, bary = locate(smap, mat(octahedral_to_sphere(image_uv(M)).reshape(-1, 3), R))
+        samples = np.einsum("ni,nij->nj", bary, smap.points[smap.faces[face]]).reshape(M, M, 3)
         seconds["sample"] = seconds.get("sample", 0.0) + time.perf_counter() - t0
+        if smoothing > 0:
+            t0 = time.perf_counter()
+            samples, _ = smooth_samples(smap.points, smap.faces, smap.sphere, samples, face,
+                                        smoothing_steps(k, smoothing))
+            seconds["smooth"] = seconds.get("smooth", 0.0) + time.perf_counter() - t0
 
         t0 = time.perf_counter()
         fit = fit_geometry_image(None, n, fairness=fairness, oversample=k, samples=samples)

@@ -121,6 +121,8 @@ class FitResult:
         CG iterations per coordinate.
     seconds : dict
         ``{"sample", "assemble", "solve"}``.
+    values : (M, M, 3) array
+        The fitted surface at the samples' parameters (``P(s_k, t_k)``).
 
     Examples
     --------
@@ -136,6 +138,7 @@ class FitResult:
     roughness: float
     iterations: tuple
     seconds: dict = field(default_factory=dict)
+    values: np.ndarray = field(default=None, repr=False)
 
 
 def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample: int = 4, samples=None,
@@ -225,8 +228,9 @@ def fit_geometry_image(surface_at, n: int, *, fairness: float = 1e-3, oversample
 
     G = (S @ x).reshape(N + 1, N + 1, 3)
     diag = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) or 1.0
-    res = np.linalg.norm(A @ x - X, axis=1) / diag
+    values = A @ x
+    res = np.linalg.norm(values - X, axis=1) / diag
     rough = float((np.linalg.norm(F @ x, axis=1) ** 2).mean()) / diag ** 2
     image = GeometryImage(G)
     return FitResult(image, float(fairness), float(np.sqrt((res ** 2).mean())), float(res.max()), rough,
-                     iterations, seconds)
+                     iterations, seconds, values.reshape(M, M, 3))
