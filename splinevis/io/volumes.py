@@ -23,7 +23,7 @@
   ``.slc``                  SLC (``vtkSLCReader``; 8-bit, no origin in the format)
   ``.raw`` ``.bin``         headerless samples: pass ``shape``, ``dtype``, ``byteorder``
   ``.cube``                 Gaussian cube (parsed here), rotated orthogonal lattice -> ``direction``
-  ``.nii`` ``.nii.gz``      NIfTI-1/-2 (nibabel), placed by the sform, else the qform, else ``pixdim``
+  ``.nii`` ``.nii.gz``      NIfTI-1/-2 (nibabel: ``splinevis[nifti]``), placed by the sform, else the qform, else ``pixdim``
   folder or glob            stack of raw slices (``shape=(ny, nx)``, ``dtype``, ``byteorder``)
   ========================  ===============================================================
 
@@ -119,8 +119,8 @@ VOLUME_EXTENSIONS = {
     ".nhdr": "NRRD detached header (parsed by splinevis)",
     ".slc": "SLC (vtkSLCReader)",
     ".cube": "Gaussian cube, rotated orthogonal lattice (parsed by splinevis)",
-    ".nii": "NIfTI-1/-2, sform/qform placement (nibabel)",
-    ".nii.gz": "gzip-compressed NIfTI-1/-2, sform/qform placement (nibabel)",
+    ".nii": "NIfTI-1/-2, sform/qform placement (nibabel: splinevis[nifti])",
+    ".nii.gz": "gzip-compressed NIfTI-1/-2, sform/qform placement (nibabel: splinevis[nifti])",
     **dict.fromkeys(_RAW_EXTENSIONS, "headerless samples (shape=, dtype=, byteorder=)"),
 }
 _UNSUPPORTED = {
