@@ -48,7 +48,7 @@ def bench_choice(repeats: int = 5) -> dict:
     terrain = franke_terrain(33, "C1")
     view = View(*CAMERA, 30.0, width=WINDOW[0], height=WINDOW[1], clipping_range=(0.05, 10.0))
     cache = {}
-    choices = [choose("terrain", terrain, view, e, cache=cache) for e in REQUESTS]
+    choices = [choose(terrain, view, e, cache=cache) for e in REQUESTS]
     levels = sorted({c.level for c in choices if c.renderer == "mesh"}) + [None]
     scenes = {k: _scene(terrain, k) for k in levels}
     for pl in scenes.values():

@@ -1,24 +1,27 @@
 """Choice of renderer by accuracy: the cheapest way to draw a spline whose screen-space error stays below
-``max_error_px`` for the current camera (``Plotter.add_terrain/add_isosurface(..., max_error_px=...)``).
+``max_error_px`` for the current camera (``Plotter.add_spline/add_terrain/add_isosurface(..., max_error_px=...)``).
 
-**The table.** :data:`RENDERERS` lists, per program, the renderers that can draw its models: a name, a cost
-rank (lower is cheaper), the levels tried in order of cost (samples per cell ``k`` for meshes), an error
-function ``error_px(model, view, level, cache) -> (pixels, proven)``, how to build it and, for meshes, a
-triangle count and the styles or models it refuses. :func:`choose` walks the table in cost order, takes the
-first entry (and for a mesh the smallest ``k``) whose error is at most ``max_error_px`` and whose triangle
-count is within :data:`TRIANGLE_CAP`; if none meets the request, the exact renderer (the ray cast) is
-chosen and the choice says that the request is not met. A mesh-guided ray cast (program option
-``proxy="mesh"``) is one more entry: its error is the ray cast's, its cost rank the measured one.
+**The renderers are part of each family's contract.** A family lists on its program
+(``SplineProgram.renderers``, :class:`splinevis.gl.renderers.Renderer`) the ways its models can be drawn: a
+name, a cost rank (lower is cheaper), the levels tried in order of cost (samples per cell ``k`` for meshes),
+an error function ``error_px(model, view, level, cache) -> (pixels, proven)``, how to build it and, for
+meshes, a triangle count and the styles or models it refuses; its error functions and builders live in its
+own folder (e.g. ``splinevis/terrain/renderers.py``). This module knows no family: :func:`choose` takes the
+renderers of ``program_for(model)`` (:func:`renderers_for`), walks them in cost order and takes the first
+(for a mesh the smallest ``k``) whose error is at most ``max_error_px`` and whose triangle count is within
+:data:`TRIANGLE_CAP`; if none meets the request, the exact renderer with the smallest error is chosen and
+the choice says that the request is not met. A program that declares no exact renderer gets its own (the
+program itself, named after its kind); one that declares no renderers at all is drawn by its own only, and
+the choice says so.
 
 **Cost ranks** come from the studies' measurements on this machine (Mesa llvmpipe, 2 cores):
 docs/results/terrain/pareto.md (800 x 600): a mesh of 2,097,152 triangles draws in 148 ms, the terrain ray
 cast in 135-242 ms; docs/results/volume/volume.md (400 x 300): marching-cubes meshes of 4,176-65,840
-triangles in 4-16 ms, the isosurface ray cast in 251-667 ms. Hence meshes rank below the ray cast and the
-triangle cap is the largest mesh measured cheaper than the ray cast; benchmarks/bench_choice.py times the
-choices beside the ray cast (docs/results/choice/choice.md: the 2,097,152-triangle mesh 1.6x cheaper). The terrain's mesh-guided proxy was
-measured slower than the box proxy on llvmpipe (about 1.15x at k = 1 to 2x at k = 4:
-:mod:`splinevis.terrain.mesh_proxy`): as a row of the table its rank would be above the ray cast's here, so
-it would be drawn only where the box ray cast is refused.
+triangles in 4-16 ms, the isosurface ray cast in 251-667 ms. Hence meshes rank below the ray cast (the
+families declare rank 0 and 10) and the triangle cap is the largest mesh measured cheaper than the ray
+cast; benchmarks/bench_choice.py times the choices beside the ray cast (docs/results/choice/choice.md: the
+2,097,152-triangle mesh 1.6x cheaper). A mesh-guided ray cast (a program option) is measured per family and
+ranked between (:mod:`splinevis.terrain.renderers`).
 
 **Screen-space error** is the distance, in pixels on the screen, between a point the renderer shows and
 the point of the exact (float64) spline it stands for; world errors become pixels by
@@ -28,43 +31,44 @@ For a mesh the displacement is bounded per cell (or cube) and the pixels are bou
 (largest r and smallest Z over its corners): the maximum over the boxes in the view frustum is the
 "nearest visible point" of the bound. A box reaching behind the eye plane (or closer than e) that meets the
 frustum makes the mesh's error unbounded (a mesh seen from that close can be off by any number of pixels):
-the ray cast is chosen. Every renderer adds the rasterizer's sub-pixel snapping, sqrt(2) 2^-8 pixels
-(:data:`splinevis.gl.error_bounds.SUBPIXEL`).
+an exact renderer is chosen. Every renderer adds the rasterizer's sub-pixel snapping, sqrt(2) 2^-8 pixels
+(:data:`splinevis.gl.error_bounds.SUBPIXEL`). The families' mesh bounds (proven or estimated) are derived
+in their renderer modules.
 
-* Terrain mesh (:mod:`splinevis.terrain.sampled_mesh`): **proven**, vertical chord <= M h^2 / 4 per cell
-  plus the float32 rounding of the vertices.
-* Isosurface mesh (:mod:`splinevis.volume.sampled_mesh`): value error on the mesh proven, turned into a
-  distance with an **estimated** lower bound of |grad s| (the smallest at the ``k = 1`` mesh's vertices).
-* Ray cast: the program's derived float32 depth bound (``SplineProgram.depth_bound``) on a grid of 32 x 24
-  sample rays, less its depth-arithmetic and depth-buffer terms (they change the depth written, not the
-  point shown; a mesh's depth has them too), turned into a distance along the ray and converted to pixels
-  as if it were sideways: an **estimate** over the screen (bounds at the sampled pixels). It over-states the
-  ray cast's error where rays graze the surface (near silhouettes): there the root, hence the depth, moves
-  along the ray by up to 2 sqrt(2 eps / |g''|) while the shown surface moves sideways by about
-  eps / |grad| only (0.15 px on the terrain study's view, against 0.66 px for a k = 4 mesh).
+A renderer that declares no error function has the program's own: for a program with a float64 twin and a
+derived depth bound, :func:`raycast_error_px`: the bound (``SplineProgram.depth_bound``) on a grid of 32 x 24
+sample rays, less its depth-arithmetic and depth-buffer terms (they change the depth written, not the point
+shown; a mesh's depth has them too), turned into a distance along the ray and converted to pixels as if it
+were sideways: an **estimate** over the screen (bounds at the sampled pixels). It over-states the ray cast's
+error where rays graze the surface (near silhouettes): there the root, hence the depth, moves along the ray
+by up to 2 sqrt(2 eps / |g''|) while the shown surface moves sideways by about eps / |grad| only (0.15 px on
+the terrain study's view, against 0.66 px for a k = 4 mesh). Other programs' own error is unknown (shown as
+such; it never meets a request).
 """
 
 from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from .gl.error_bounds import U32, depth_error
+from .gl.error_bounds import depth_error
+from .gl.renderers import Choice, Option, Renderer
 from .gl.screen_error import SNAP_PX, View
 from .plotting_options import split_read_options
 
-__all__ = ["Renderer", "Option", "Choice", "RENDERERS", "TRIANGLE_CAP", "choose", "check_max_error",
-           "add_by_accuracy", "raycast_error_px"]
+__all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_for", "check_max_error",
+           "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px"]
 
 log = logging.getLogger("splinevis")
 
 #: Largest mesh (triangles) the choice builds: the largest mesh measured cheaper than the ray cast
 #: (docs/results/terrain/pareto.md: 1025 x 1025 vertices, 2,097,152 triangles, 148 ms vs 135-242 ms).
 TRIANGLE_CAP = 2_097_152
+
+#: Keywords of ``add_spline`` that go to the program, not to the style.
+_SPLINE_KEYS = ("name", "newton_iterations", "program_options", "program")
 
 
 def check_max_error(max_error_px) -> float:
@@ -82,127 +86,11 @@ def check_max_error(max_error_px) -> float:
     return float(max_error_px)
 
 
-@dataclass(frozen=True)
-class Renderer:
-    """One row of :data:`RENDERERS` (module docstring): ``error_px(model, view, level, cache) -> (pixels,
-    proven)``; ``build(plotter, model, style, level, cache, spline_options, add_options) -> actor``;
-    ``triangles(model, level, cache) -> int`` (None: not a mesh); ``refuses(model, style) -> reason or None``;
-    ``exact``: draws the spline itself (what is drawn when nothing meets the request).
-
-    >>> Renderer("raycast", 10, (None,), raycast_error_px, build=None).name
-    'raycast'
-    """
-
-    name: str
-    rank: int
-    levels: tuple
-    error_px: Callable
-    build: Callable | None
-    triangles: Callable | None = None
-    refuses: Callable | None = None
-    exact: bool = False
-
-
-@dataclass(frozen=True)
-class Option:
-    """A renderer considered: its name, level (``k``; None for ray casts), screen-space error (pixels),
-    whether that error is proven, triangles (meshes), whether it meets the request and why not.
-
-    >>> str(Option("mesh", 2, 0.8, True, 1024, True))
-    'mesh k=2 0.8 px (proven, 1,024 triangles)'
-    """
-
-    name: str
-    level: object
-    error_px: float
-    proven: bool
-    triangles: int | None = None
-    meets: bool = False
-    reason: str = ""
-
-    def __str__(self):
-        label = self.name + ("" if self.level is None else f" k={self.level}")
-        if self.reason:
-            return f"{label}: {self.reason}"
-        extra = "proven" if self.proven else "estimate"
-        if self.triangles is not None:
-            extra += f", {self.triangles:,} triangles"
-        return f"{label} {self.error_px:.3g} px ({extra})"
-
-
-@dataclass(frozen=True)
-class Choice:
-    """What :func:`choose` picked (``chosen``), for which request and ``view``, among ``options`` (every
-    candidate looked at, in cost order); ``meets`` is False when no renderer reaches ``max_error_px`` (the
-    exact renderer, the ray cast, is drawn then).
-
-    >>> c = Choice("terrain", 0.5, Option("mesh", 2, 0.4, True, 512, True), (Option("mesh", 1, 1.6, True, 128),))
-    >>> c.renderer, c.level, c.meets
-    ('mesh', 2, True)
-    >>> c.message
-    'splinevis: terrain drawn as mesh k=2 0.4 px (proven, 512 triangles) <= max_error_px=0.5; considered: mesh k=1 1.6 px (proven, 128 triangles)'
-    """
-
-    program: str
-    max_error_px: float
-    chosen: Option
-    options: tuple
-    view: View | None = field(default=None, repr=False)
-
-    @property
-    def renderer(self) -> str:
-        """Name of the chosen renderer.
-
-        >>> Choice("terrain", 0.5, Option("raycast", None, 0.01, False, meets=True), ()).renderer
-        'raycast'
-        """
-        return self.chosen.name
-
-    @property
-    def level(self):
-        """Level of the chosen renderer (samples per cell ``k`` of a mesh; None for a ray cast).
-
-        >>> Choice("terrain", 0.5, Option("mesh", 3, 0.3, True, 4608, True), ()).level
-        3
-        """
-        return self.chosen.level
-
-    @property
-    def error_px(self) -> float:
-        """Screen-space error of the chosen renderer, pixels.
-
-        >>> Choice("terrain", 0.5, Option("mesh", 3, 0.3, True, 4608, True), ()).error_px
-        0.3
-        """
-        return self.chosen.error_px
-
-    @property
-    def meets(self) -> bool:
-        """Whether the chosen renderer's error is within ``max_error_px``.
-
-        >>> Choice("terrain", 1e-4, Option("raycast", None, 0.006, False), ()).meets
-        False
-        """
-        return self.chosen.meets
-
-    @property
-    def message(self) -> str:
-        """One line: what was chosen, its error against the request, the alternatives considered.
-
-        >>> Choice("terrain", 1e-4, Option("raycast", None, 0.006, False), ()).message
-        'splinevis: terrain drawn as raycast 0.006 px (estimate); nothing meets max_error_px=0.0001, drawing the exact renderer'
-        """
-        head = f"splinevis: {self.program} drawn as {self.chosen}"
-        head += (f" <= max_error_px={self.max_error_px:g}" if self.meets
-                 else f"; nothing meets max_error_px={self.max_error_px:g}, drawing the exact renderer")
-        others = [str(o) for o in self.options if o is not self.chosen]
-        return head + ("; considered: " + ", ".join(others) if others else "")
-
-
 # ---------------------------------------------------------------------------------------------- ray cast
 def raycast_error_px(model, view, level, cache, *, rays=(32, 24)):
     """(pixels, False): the program's float32 depth bound on ``rays`` sample rays converted to pixels
-    (module docstring), plus the sub-pixel snapping; the program is ``cache["program"]``.
+    (module docstring), plus the sub-pixel snapping; the program is ``cache["program"]`` (a
+    :class:`~splinevis.gl.contract.SplineProgram` or a registered name).
 
     >>> import numpy as np
     >>> from splinevis.terrain.model import TerrainSpline
@@ -214,9 +102,8 @@ def raycast_error_px(model, view, level, cache, *, rays=(32, 24)):
     (0.011, 0.0055, False)
     """
     from .gl.camera import pixel_rays, window_depth
-    from .programs import get
 
-    program = get(cache["program"])
+    program = _program(model, cache["program"])
     m = view.matrix()
     o, d = pixel_rays(m, *rays)
     o, d = o.reshape(-1, 3), d.reshape(-1, 3)
@@ -236,160 +123,65 @@ def raycast_error_px(model, view, level, cache, *, rays=(32, 24)):
     return float(view.point_pixels(o + t[:, None] * d, world).max()) + SNAP_PX, False
 
 
-def _add_raycast(plotter, model, style, level, cache, spline_options, add_options):
-    from .programs import get
+def _unknown_error_px(model, view, level, cache):
+    return math.inf, False
 
-    actor = plotter.add_spline(model, style, **spline_options)
-    program = get(cache["program"])
+
+def _add_own(plotter, model, style, level, cache, spline_options, add_options, renderer):
+    """The program draws the model itself, with the renderer's program options, then runs its ``on_add``."""
+    program = cache["program"]
+    options = dict(spline_options, program=program.name)
+    if renderer.program_options:
+        options["program_options"] = {**options.get("program_options", {}), **dict(renderer.program_options)}
+    actor = plotter.add_spline(model, style, **options)
     if program.on_add is not None:
         program.on_add(actor, plotter, **(add_options or {}))
     return actor
 
 
-def _mesh_refuses(model, style):
-    from .gl.mesh_effects import MESH_EFFECTS
+def _program(model, program):
+    from .programs import get, program_for
 
-    extra = sorted(set(style.effect_set()) - MESH_EFFECTS)
-    if extra:
-        return f"a mesh cannot show {', '.join(extra)}"
-    if style.output == "curvature":
-        return "a mesh has no curvature array"
-    return None
+    if program is None:
+        return program_for(model)
+    return get(program) if isinstance(program, str) else program
 
 
-def _float32_margin(lo, hi):
-    """World error of float32 vertex positions and their 4-term transform: 8 u of the largest coordinate."""
-    return 8.0 * U32 * float(np.abs(np.concatenate([lo, hi])).max())
+def _own_error(program):
+    """The error function of the program's own renderers (module docstring)."""
+    return raycast_error_px if program.reference is not None and program.depth_bound is not None else _unknown_error_px
 
 
-def _add_mesh(plotter, mesh, style, spline_options):
-    from .gl.mesh_effects import add_mesh_with_effects
+def renderers_for(program) -> tuple:
+    """``(renderers, note)``: the renderers :func:`choose` walks for ``program`` (a SplineProgram or a
+    registered name) in cost order, its own exact renderer added when it declares none (module docstring),
+    and what the choice says about that ("" when the program declares an exact renderer).
 
-    unknown = sorted(set(spline_options) - {"name", "newton_iterations"})  # the root finder's: unused by a mesh
-    if unknown:
-        raise TypeError(f"options {unknown} are ray-cast program options; the chosen renderer is a mesh.")
-    return add_mesh_with_effects(plotter, mesh, style, name=spline_options.get("name"))
-
-
-# ------------------------------------------------------------------------------------------ terrain mesh
-def _terrain_cache(model, cache):
-    from .terrain import sampled_mesh as sm
-
-    if "boxes" not in cache:
-        lo, hi = sm.cell_boxes(model)
-        cache["boxes"] = (lo.reshape(-1, 3), hi.reshape(-1, 3))
-        cache["hessian"] = sm.chord_bounds(model, 1).reshape(-1) * 4.0  # M: the k = 1 chord bound is M / 4
-    return cache["boxes"], cache["hessian"]
-
-
-def _terrain_mesh_error(model, view, k, cache):
-    (lo, hi), M = _terrain_cache(model, cache)
-    err = M / (4.0 * k * k) + _float32_margin(lo, hi)  # chord_bounds(model, k) without recomputing M
-    return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, True
+    >>> [(r.name, r.rank, r.exact) for r in renderers_for("terrain")[0]]
+    [('mesh', 0, False), ('mesh_guided', 5, True), ('raycast', 10, True)]
+    >>> rows, note = renderers_for("analytic_patch")
+    >>> [(r.name, r.exact) for r in rows], note
+    ([('raycast', True)], "program 'analytic_patch' declares no renderers: drawn by its own (raycast), its error estimated")
+    """
+    program = _program(None, program)
+    rows = tuple(program.renderers)
+    note = ""
+    if not any(r.exact for r in rows):
+        name = program.kind if program.kind not in {r.name for r in rows} else "program"
+        rows += (Renderer(name, max((r.rank for r in rows), default=0) + 1, exact=True),)
+        error = "its error estimated" if _own_error(program) is raycast_error_px else "its error unknown"
+        note = (f"program {program.name!r} declares " + ("no exact renderer: its own" if len(rows) > 1
+                else "no renderers: drawn by its own") + f" ({program.kind}), {error}")
+    return tuple(sorted(rows, key=lambda r: r.rank)), note
 
 
-def _terrain_mesh_triangles(model, k, cache):
-    from .terrain.sampled_mesh import mesh_triangles
-
-    return mesh_triangles(model, k)
-
-
-def _terrain_mesh_build(plotter, model, style, k, cache, spline_options, add_options):
-    from .terrain.sampled_mesh import sampled_mesh
-
-    return _add_mesh(plotter, sampled_mesh(model, k), style, spline_options)
-
-
-# --------------------------------------------------------------------------------------- isosurface mesh
-def _iso_mesh1(model, cache):
-    """The k = 1 mesh (its triangle count scales the others'; its vertices give the gradient estimate)."""
-    from .volume.sampled_mesh import sampled_mesh
-
-    if ("mesh", 1) not in cache:
-        cache["mesh", 1] = sampled_mesh(model.spline, model.isovalue, 1, model.relevant)
-    return cache["mesh", 1]
-
-
-def _iso_cache(model, cache):
-    from .volume import sampled_mesh as sm
-
-    if "hessian" not in cache:
-        spline = model.spline
-        cubes = model.relevant.cubes
-        h = np.asarray(spline.spacing, dtype=np.float64)
-        lo = np.asarray(spline.origin, dtype=np.float64) - 0.5 * h + cubes * h
-        cache["boxes"] = (lo, lo + h)
-        cache["hessian"] = sm.hessian_bounds(spline, cubes) if len(cubes) else np.zeros(0)
-        cache["gradient"] = sm.gradient_floor(spline, _iso_mesh1(model, cache))
-    return cache
-
-
-def _iso_mesh_error(model, view, k, cache):
-    c = _iso_cache(model, cache)
-    lo, hi = c["boxes"]
-    if len(lo) == 0:
-        return SNAP_PX, False
-    h = np.asarray(model.spline.spacing, dtype=np.float64) / k
-    delta = c["hessian"] * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)  # as volume.sampled_mesh.distance_estimates
-    g = c["gradient"]
-    err = (delta / g if g > 0 else np.full(len(delta), np.inf)) + _float32_margin(lo, hi)
-    return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, False
-
-
-def _iso_mesh_triangles(model, k, cache):
-    from .volume.sampled_mesh import fine_points, MAX_FINE_POINTS
-
-    if fine_points(model.spline, k) > MAX_FINE_POINTS:
-        raise ValueError(f"{fine_points(model.spline, k):,} fine samples (more than {MAX_FINE_POINTS:,})")
-    return int(_iso_mesh1(model, cache).n_cells) * k * k  # surface area / fine cell area ~ k^2
-
-
-def _iso_mesh_build(plotter, model, style, k, cache, spline_options, add_options):
-    from .volume.sampled_mesh import sampled_mesh
-
-    mesh = cache.get(("mesh", k))
-    if mesh is None:
-        mesh = sampled_mesh(model.spline, model.isovalue, k, model.relevant)
-    return _add_mesh(plotter, mesh, style, spline_options)
-
-
-def _iso_refuses(model, style):
-    if not np.allclose(np.asarray(model.spline.grid.direction, dtype=np.float64), np.eye(3)):
-        return "rotated lattices are drawn by the ray cast only"
-    return _mesh_refuses(model, style)
-
-
-_MESH_K = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64)
-
-
-def _add_mesh_guided(plotter, model, style, level, cache, spline_options, add_options):
-    options = dict(spline_options)
-    options["program_options"] = {**options.get("program_options", {}), "proxy": "mesh", "mesh_samples": 1}
-    return _add_raycast(plotter, model, style, level, cache, options, add_options)
-
-
-#: Renderers per program, any order (sorted by ``rank`` when used). The mesh-guided ray cast draws the same
-#: picture as the ray cast (the same hard cases agree with the float64 twin) at 2.5-4x less time per frame on
-#: this machine (benchmarks/bench_mesh_guided.py), so it ranks between meshes and the box ray cast.
-RENDERERS = {
-    "terrain": (
-        Renderer("mesh", 0, _MESH_K, _terrain_mesh_error, _terrain_mesh_build, _terrain_mesh_triangles, _mesh_refuses),
-        Renderer("mesh_guided", 5, (None,), raycast_error_px, _add_mesh_guided, exact=True),
-        Renderer("raycast", 10, (None,), raycast_error_px, _add_raycast, exact=True),
-    ),
-    "isosurface": (
-        Renderer("mesh", 0, _MESH_K[:8], _iso_mesh_error, _iso_mesh_build, _iso_mesh_triangles, _iso_refuses),
-        Renderer("raycast", 10, (None,), raycast_error_px, _add_raycast, exact=True),
-    ),
-}
-
-
-def choose(program: str, model, view: View, max_error_px: float, style=None, *,
-           triangle_cap: int = TRIANGLE_CAP, cache: dict | None = None, exclude: dict | None = None) -> Choice:
-    """The cheapest renderer of :data:`RENDERERS[program] <RENDERERS>` meeting ``max_error_px`` for ``view``
-    (module docstring). Every renderer's error is computed (meshes: up to the first ``k`` that meets the
-    request or the cap) so that the choice can say what it passed over. ``exclude`` maps renderer names to
-    the reason they may not be used.
+def choose(model, view: View, max_error_px: float, style=None, *, program=None, triangle_cap: int = TRIANGLE_CAP,
+           cache: dict | None = None, exclude: dict | None = None) -> Choice:
+    """The cheapest renderer of ``model``'s program (``program``: a name or SplineProgram; default
+    ``program_for(model)``) meeting ``max_error_px`` for ``view`` (module docstring). Every renderer's error is
+    computed (meshes: up to the first ``k`` that meets the request or the cap) so that the choice can say what
+    it passed over. ``exclude`` maps renderer names to the reason they may not be used; ``cache`` (a dict)
+    keeps what the error functions computed for this model across calls.
 
     Examples
     --------
@@ -398,22 +190,22 @@ def choose(program: str, model, view: View, max_error_px: float, style=None, *,
     >>> y, x = np.mgrid[0:17, 0:17] / 16.0
     >>> t = TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
     >>> v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240)
-    >>> [(c.renderer, c.level) for c in (choose("terrain", t, v, e) for e in (2.0, 0.2, 0.02))]
+    >>> [(c.renderer, c.level) for c in (choose(t, v, e) for e in (2.0, 0.2, 0.02))]
     [('mesh', 1), ('mesh', 3), ('mesh', 12)]
-    >>> c = choose("terrain", t, v, 0.02, triangle_cap=50_000)  # k = 12 has 73,728 triangles
+    >>> c = choose(t, v, 0.02, triangle_cap=50_000)  # k = 12 has 73,728 triangles
     >>> c.renderer, c.meets, [str(o) for o in c.options[-3:]]  # the exact renderers: the cheaper one
     ('mesh_guided', True, ['mesh k=12: over the cap of 50,000 triangles', 'mesh_guided 0.0177 px (estimate)', 'raycast 0.0177 px (estimate)'])
     """
     from .effects import Style
 
     max_error_px = check_max_error(max_error_px)
-    if program not in RENDERERS:
-        raise ValueError(f"no renderer table for program {program!r}; known: {', '.join(sorted(RENDERERS))}.")
+    program = _program(model, program)
+    rows, note = renderers_for(program)
     style = Style() if style is None else style
     cache = {} if cache is None else cache
     cache["program"] = program
     options, chosen = [], None
-    for r in sorted(RENDERERS[program], key=lambda r: r.rank):
+    for r in rows:
         reason = (exclude or {}).get(r.name) or (r.refuses(model, style) if r.refuses is not None else None)
         if reason:
             options.append(Option(r.name, None, math.inf, False, reason=reason))
@@ -427,38 +219,42 @@ def choose(program: str, model, view: View, max_error_px: float, style=None, *,
             if tri is not None and tri > triangle_cap:
                 options.append(Option(r.name, level, math.inf, False, tri, reason=f"over the cap of {triangle_cap:,} triangles"))
                 break
-            px, proven = r.error_px(model, view, level, cache)
+            px, proven = (r.error_px or _own_error(program))(model, view, level, cache)
             options.append(Option(r.name, level, float(px), proven, tri, meets=px <= max_error_px))
             if px <= max_error_px:
                 break
         if chosen is None:
             chosen = next((o for o in options if o.meets), None)
-    if chosen is None:  # the exact renderer: its error estimate over-states grazing rays (module docstring)
-        exact = {r.name for r in RENDERERS[program] if r.exact}
+    if chosen is None:  # an exact renderer: its error estimate over-states grazing rays (module docstring)
+        exact = {r.name for r in rows if r.exact}
         pool = [o for o in options if not o.reason]
+        if not pool:
+            raise ValueError(f"no renderer of program {program.name!r} may draw this: "
+                             + "; ".join(str(o) for o in options) + ".")
         chosen = min([o for o in pool if o.name in exact] or pool, key=lambda o: o.error_px)
-    return Choice(program, max_error_px, chosen, tuple(options), view)
+    return Choice(program.name, max_error_px, chosen, tuple(options), view, note)
 
 
-def _model_bounds(model):
-    if hasattr(model, "spline"):  # an isosurface: the spline's domain
-        return tuple(model.spline.bounds)
-    x0, x1, y0, y1 = model.extent
-    z0, z1 = model.zrange
-    return (x0, x1, y0, y1, z0, z1)
+def _model_bounds(model, program, style):
+    """World bounds the default camera is fitted to: ``model.bounds`` if the model has them, else those of
+    what the program builds (its proxy, or its dataset)."""
+    b = getattr(model, "bounds", None)
+    if b is not None:
+        return tuple(float(v) for v in b)
+    built = program.make(model, style)
+    if hasattr(built, "bounds"):
+        return tuple(built.bounds)
+    p = np.asarray(built.points, dtype=np.float64) + np.asarray(built.offset, dtype=np.float64)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
 
 
 def add_by_accuracy(plotter, program: str, args, read_options, style, options, max_error_px, *, style_from,
                     add_options=None):
     """Build the model of ``program`` from ``args``, choose its renderer for ``max_error_px`` and add it
-    (what ``Plotter.add_terrain/add_isosurface(..., max_error_px=...)`` do).
-
-    The view is the plotter's camera if it was set, else pyvista's default view fitted to the model's bounds
-    (what the first render would show); the camera is then set to that view (moving it closer afterwards
-    can break the request: call again or choose for the final camera). The reader's keywords (``order``,
-    ``spacing``, ``origin``) may be in ``options`` as in ``read_options``
-    (:func:`splinevis.plotting_options.split_read_options`). The actor gets ``renderer_choice`` (a
-    :class:`Choice`); the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
+    (what ``Plotter.add_terrain/add_isosurface(..., max_error_px=...)`` do; :func:`add_model_by_accuracy`).
+    The reader's keywords (``order``, ``spacing``, ``origin``) may be in ``options`` as in ``read_options``
+    (:func:`splinevis.plotting_options.split_read_options`).
 
     Examples
     --------
@@ -471,19 +267,59 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
     ('mesh', True)
     >>> pl.close()
     """
-    from vtkmodules.vtkRenderingCore import vtkCamera
-
     from .programs import get
 
     max_error_px = check_max_error(max_error_px)
     read_options, options = split_read_options(program, read_options, options)
-    spline_options = {k: options.pop(k) for k in ("name", "newton_iterations", "program_options", "program")
-                      if k in options}
+    spline_options = {k: options.pop(k) for k in _SPLINE_KEYS if k in options}
     st = style_from(style, options)
     model = get(program).model_from(*args, **read_options)
+    return add_model_by_accuracy(plotter, model, st, max_error_px, add_options=add_options, **spline_options)
+
+
+def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=None, program=None, **spline_options):
+    """Choose the renderer of ``model`` (its program's, or the one named ``program``) for ``max_error_px`` and
+    add it (what ``Plotter.add_spline(model, max_error_px=...)`` does); ``style`` is a Style,
+    ``spline_options`` are ``add_spline``'s ``name``, ``newton_iterations``, ``program_options`` (None: not
+    given), ``add_options`` go to the program's ``on_add``.
+
+    The view is the plotter's camera if it was set, else pyvista's default view fitted to the model's bounds
+    (what the first render would show); the camera is then set to that view (moving it closer afterwards
+    can break the request: call again or choose for the final camera). Ray-cast options (``program_options``,
+    ``program``) exclude every renderer but the program's own plain one. The actor gets ``renderer_choice`` (a
+    :class:`Choice`) and ``model``; the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
+
+    Examples
+    --------
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> from splinevis.effects import Style
+    >>> from splinevis.plotting import Plotter
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> actor = add_model_by_accuracy(pl, QuarticTrianglePatch.demo(), Style(), 0.5)
+    >>> actor.renderer_choice.renderer, actor.renderer_choice.meets  # it declares none: its own ray cast
+    ('raycast', True)
+    >>> pl.close()
+    """
+    import os
+    from functools import partial
+
+    from vtkmodules.vtkRenderingCore import vtkCamera
+
+    max_error_px = check_max_error(max_error_px)
+    spline_options = {k: v for k, v in spline_options.items() if v is not None}
+    unknown = sorted(set(spline_options) - set(_SPLINE_KEYS))
+    if unknown:
+        raise TypeError(f"unknown options {unknown}; add_spline takes {', '.join(_SPLINE_KEYS)} besides the style.")
+    prog = _program(model, program)
+    if program is not None:
+        spline_options["program"] = prog.name
+    if not isinstance(model, prog.model_type):  # a file or a type the program converts (SplineProgram.converts)
+        if prog.model_from is None or not isinstance(model, (str, os.PathLike) + tuple(prog.converts)):
+            raise TypeError(f"program {prog.name!r} draws {prog.model_type.__name__}, not {type(model).__name__}.")
+        model = prog.model_from(model)
     ren = plotter.renderer
     if not ren.camera_set:  # pyvista's view at the first render: the theme's direction, fitted to the bounds
-        b = list(_model_bounds(model))
+        b = list(_model_bounds(model, prog, style))
         vb = ren.ComputeVisiblePropBounds()
         if vb[0] <= vb[1]:
             b = [min(b[i], vb[i]) if i % 2 == 0 else max(b[i], vb[i]) for i in range(6)]
@@ -494,13 +330,16 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
     cam = ren.GetActiveCamera()
     saved = vtkCamera()
     saved.DeepCopy(cam)
+    rows, _ = renderers_for(prog)
     given = sorted({"program_options", "program"} & set(spline_options))
-    exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in RENDERERS[program]
-               if given and r.name != "raycast"}  # meshes take none; the mesh-guided build sets its own
-    choice = choose(program, model, View.from_renderer(ren, plotter.window_size), max_error_px, st,
+    # meshes take no ray-cast options; a renderer with program options of its own (mesh-guided) sets them
+    plain = {r.name for r in rows if r.build is None and not r.program_options}
+    exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in rows if given and r.name not in plain}
+    choice = choose(model, View.from_renderer(ren, plotter.window_size), max_error_px, style, program=prog,
                     cache=(cache := {}), exclude=exclude)
-    entry = next(r for r in RENDERERS[program] if r.name == choice.renderer)
-    actor = entry.build(plotter, model, st, choice.level, cache, spline_options, add_options)
+    entry = next(r for r in rows if r.name == choice.renderer)
+    build = entry.build or partial(_add_own, renderer=entry)
+    actor = build(plotter, model, style, choice.level, cache, spline_options, add_options)
     cam.DeepCopy(saved)
     ren.ResetCameraClippingRange()
     for key, value in (("renderer_choice", choice), ("model", model)):

@@ -142,7 +142,7 @@ def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
     t = _franke_like()
     v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 5))
     cache = {}
-    picks = [choose("terrain", t, v, e, triangle_cap=50_000, cache=cache) for e in (4.0, 1.0, 0.3, 0.1, 0.03, 0.02)]
+    picks = [choose(t, v, e, triangle_cap=50_000, cache=cache) for e in (4.0, 1.0, 0.3, 0.1, 0.03, 0.02)]
     ks = [c.level for c in picks if c.renderer == "mesh"]
     assert [c.renderer for c in picks] == ["mesh"] * 5 + ["mesh_guided"]
     assert ks == sorted(ks) and ks[0] == 1 and ks[-1] > ks[0]
@@ -157,7 +157,7 @@ def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
     assert mesh[2] / mesh[4] == pytest.approx(4.0, rel=0.05)
     # nothing meets a request below the sub-pixel snapping: the cheapest exact ray cast is drawn and the choice
     # says so
-    c = choose("terrain", t, v, 1e-4, triangle_cap=50_000, cache=cache)
+    c = choose(t, v, 1e-4, triangle_cap=50_000, cache=cache)
     assert not c.meets and c.renderer == "mesh_guided" and "nothing meets" in c.message
 
 
@@ -202,3 +202,27 @@ def test_ray_cast_options_exclude_the_mesh():
     assert choice.renderer == "raycast" and "program_options given" in choice.message
     assert actor.spec.defines["SV_ROOTS_PAPER"]
     pl.close()
+
+
+def test_choice_module_knows_no_family():
+    # The renderers are part of each family's contract (SplineProgram.renderers, declared in the family's
+    # folder): splinevis/choice.py imports no family module, even lazily, and its table is gone.
+    import ast
+    from pathlib import Path
+
+    import splinevis.choice as choice
+    from splinevis import programs
+
+    families = {m.split(".")[1] for m in programs.BUILTIN}
+    tree = ast.parse(Path(choice.__file__).read_text())
+    modules = set()  # choice.py sits in the package's top level: ".x" is "splinevis.x"
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            modules.add(("splinevis." if node.level == 1 else "") + (node.module or ""))
+        elif isinstance(node, ast.Import):
+            modules.update(a.name for a in node.names)
+    imported = {m.split(".")[1] for m in modules if m.startswith("splinevis.")}
+    assert "gl" in imported and "programs" in imported  # the walk sees the lazy imports too
+    assert families & imported == set() and not hasattr(choice, "RENDERERS")
+    assert [r.name for r in programs.get("terrain").renderers] == ["mesh", "mesh_guided", "raycast"]
+    assert [r.name for r in programs.get("isosurface").renderers] == ["mesh", "raycast"]

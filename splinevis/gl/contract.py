@@ -38,6 +38,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .renderers import Renderer
+
 __all__ = ["KINDS", "SplineProgram", "HardCase", "RayHits"]
 
 #: The four ways a program makes its pixels (module docstring).
@@ -182,6 +184,9 @@ class SplineProgram:
         Names of the program options ``build`` accepts (for messages and documentation).
     description : str
         One line for listings.
+    renderers : tuple of :class:`~splinevis.gl.renderers.Renderer`
+        The ways its models can be drawn, each with a cost rank and its screen-space error as a function of
+        the view, for the choice by accuracy (:mod:`splinevis.choice`); empty: the program itself only.
 
     Examples
     --------
@@ -211,6 +216,7 @@ class SplineProgram:
     options: tuple = ()
     description: str = ""
     converts: tuple = ()
+    renderers: tuple = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -223,6 +229,10 @@ class SplineProgram:
             raise TypeError(f"SplineProgram {self.name!r}: build must be callable.")
         if self.converts and self.model_from is None:
             raise ValueError(f"SplineProgram {self.name!r}: converts needs a model_from that does the conversion.")
+        if not isinstance(self.renderers, tuple) or not all(isinstance(r, Renderer) for r in self.renderers):
+            raise TypeError(f"SplineProgram {self.name!r}: renderers must be a tuple of splinevis.gl.renderers.Renderer.")
+        if len({r.name for r in self.renderers}) < len(self.renderers):
+            raise ValueError(f"SplineProgram {self.name!r}: two renderers have the same name.")
         if self.kind == "raycast" and (self.reference is None or self.depth_bound is None):
             raise ValueError(f"SplineProgram {self.name!r}: a raycast program needs its float64 twin "
                              "(reference) and its derived depth_bound; the tests compare the GPU against them.")

@@ -212,6 +212,16 @@ class TerrainSpline:
         return (self.z_ref + float(self._c.min()), self.z_ref + float(self._c.max()))
 
     @property
+    def bounds(self) -> tuple:
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)``: the domain and :attr:`zrange` (world; what a camera is
+        fitted to, as a PyVista dataset's bounds).
+
+        >>> TerrainSpline.from_heights(np.full((4, 6), 7.0), "linear", spacing=(10.0, 5.0)).bounds
+        (0.0, 50.0, 0.0, 15.0, 7.0, 7.0)
+        """
+        return (*self.extent, *self.zrange)
+
+    @property
     def offset(self) -> np.ndarray:
         """Origin of the local (model) frame: domain centre and z_ref, float64.
 

@@ -19,6 +19,7 @@ from .hard_cases import hard_cases
 from .limits import check_grid_size
 from .model import TerrainSpline
 from .raycast import raycast_terrain
+from .renderers import RENDERERS
 
 __all__ = ["terrain_program", "coefficient_table", "hierarchy_table", "check_grid_size", "terrain_depth_bound",
            "debug_defines", "DEBUG_MODES", "PROGRAM"]
@@ -287,4 +288,5 @@ PROGRAM = SplineProgram(
     "terrain", "raycast", TerrainSpline, terrain_program, reference=raycast_terrain, depth_bound=terrain_depth_bound,
     hard_cases=hard_cases, model_from=_model_from, root_methods=ROOTS, newton_iterations=8,
     options=("max_steps", "hierarchy", "roots", "rows_per_texture", "debug", "proxy", "mesh_samples", "mesh_steps"),
-    description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree")
+    description="quartic spline on the type-1 triangulation of a height grid, ray-cast through a min/max quadtree",
+    renderers=RENDERERS)

@@ -63,6 +63,16 @@ class Isosurface:
         b = self.spline.bounds
         return (b[0], b[1], b[2], b[3])
 
+    @property
+    def bounds(self) -> tuple:
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the spline's domain (lattice frame; what a camera is
+        fitted to, as a PyVista dataset's bounds).
+
+        >>> Isosurface(VolumeSpline(np.zeros((4, 4, 4)), spacing=(0.5, 1.0, 1.0), order="zyx"), 0.0).bounds
+        (-0.25, 1.75, -0.5, 3.5, -0.5, 3.5)
+        """
+        return tuple(self.spline.bounds)
+
 
 def value_reference(spline: VolumeSpline) -> float:
     """The value subtracted from the data before float32 upload (mid-range; isovalue independent).

@@ -34,6 +34,7 @@ from .isosurface import Isosurface, value_reference
 from .model import Relevant, VolumeSpline
 from .proxies import BLOCK_SIZE, proxy_geometry, proxy_units
 from .raycast import raycast_isosurface
+from .renderers import RENDERERS
 from .tables import coefficient_table, data_texture, determining_table, mask_texture
 
 __all__ = ["Isosurface", "isosurface_program", "set_isovalue", "isosurface_depth_bound", "attach_culling",
@@ -423,4 +424,5 @@ PROGRAM = SplineProgram(
     "isosurface", "raycast", Isosurface, isosurface_program, reference=raycast_world,
     depth_bound=isosurface_depth_bound, hard_cases=hard_cases, model_from=_model_from, on_add=attach_culling,
     root_methods=ROOTS, newton_iterations=6, options=("encoding", "roots", "color_field", "proxy", "block_size"),
-    description="isosurface of a trivariate spline on the type-6 partition, ray-cast in relevant cubes")
+    description="isosurface of a trivariate spline on the type-6 partition, ray-cast in relevant cubes",
+    renderers=RENDERERS)

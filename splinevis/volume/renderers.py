@@ -1,0 +1,102 @@
+"""The isosurface's renderers for the choice by accuracy (``Plotter.add_isosurface(..., max_error_px=...)``,
+:mod:`splinevis.choice`), declared on its program as :data:`RENDERERS`.
+
+* ``mesh``: flying edges of the spline's values at ``k`` samples per cube
+  (:mod:`splinevis.volume.sampled_mesh`). The value error on the mesh is proven,
+  |s - iso| <= M (e^2/8 + D^2/2) (edge interpolation plus the triangle's chord; e the largest fine spacing, D
+  the fine cell's diagonal, M the Hessian bound per relevant cube); it is turned into a distance with an
+  **estimated** lower bound of |grad s| (the smallest at the ``k = 1`` mesh's vertices), plus the float32
+  rounding of the vertices, and into pixels over each relevant cube's box. Rank 0; rotated lattices are
+  refused (the mesh is built in the lattice frame).
+* ``raycast``: the program itself, rank 10.
+
+Ranks are the measured costs of :mod:`splinevis.choice` (docs/results/volume/volume.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
+from ..gl.screen_error import SNAP_PX
+
+__all__ = ["mesh_error_px", "RENDERERS"]
+
+
+def _mesh1(surface, cache):
+    """The k = 1 mesh (its triangle count scales the others'; its vertices give the gradient estimate)."""
+    from .sampled_mesh import sampled_mesh
+
+    if ("mesh", 1) not in cache:
+        cache["mesh", 1] = sampled_mesh(surface.spline, surface.isovalue, 1, surface.relevant)
+    return cache["mesh", 1]
+
+
+def _bounds(surface, cache):
+    from . import sampled_mesh as sm
+
+    if "hessian" not in cache:
+        spline = surface.spline
+        cubes = surface.relevant.cubes
+        h = np.asarray(spline.spacing, dtype=np.float64)
+        lo = np.asarray(spline.origin, dtype=np.float64) - 0.5 * h + cubes * h
+        cache["boxes"] = (lo, lo + h)
+        cache["hessian"] = sm.hessian_bounds(spline, cubes) if len(cubes) else np.zeros(0)
+        cache["gradient"] = sm.gradient_floor(spline, _mesh1(surface, cache))
+    return cache
+
+
+def mesh_error_px(surface, view, k, cache):
+    """(pixels, False): the estimated screen-space error of the mesh at ``k`` samples per cube for ``view``
+    (module docstring), plus the sub-pixel snapping.
+
+    >>> import numpy as np
+    >>> from splinevis.gl.screen_error import View
+    >>> from splinevis.volume.isosurface import Isosurface
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> z, y, x = np.mgrid[-1:1:20j, -1:1:20j, -1:1:20j]
+    >>> s = VolumeSpline(np.sqrt(x**2 + y**2 + z**2), spacing=(2 / 19,) * 3, origin=(-1, -1, -1))
+    >>> v = View((3, -4, 2), (0, 0, 0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 20))
+    >>> cache = {}
+    >>> [round(mesh_error_px(Isosurface(s, 0.7), v, k, cache)[0], 3) for k in (1, 2, 4)]
+    [4.213, 1.037, 0.262]
+    """
+    c = _bounds(surface, cache)
+    lo, hi = c["boxes"]
+    if len(lo) == 0:
+        return SNAP_PX, False
+    h = np.asarray(surface.spline.spacing, dtype=np.float64) / k
+    delta = c["hessian"] * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)  # as sampled_mesh.distance_estimates
+    g = c["gradient"]
+    err = (delta / g if g > 0 else np.full(len(delta), np.inf)) + float32_margin(lo, hi)
+    return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, False
+
+
+def _mesh_triangles(surface, k, cache):
+    from .sampled_mesh import MAX_FINE_POINTS, fine_points
+
+    if fine_points(surface.spline, k) > MAX_FINE_POINTS:
+        raise ValueError(f"{fine_points(surface.spline, k):,} fine samples (more than {MAX_FINE_POINTS:,})")
+    return int(_mesh1(surface, cache).n_cells) * k * k  # surface area / fine cell area ~ k^2
+
+
+def _mesh_build(plotter, surface, style, k, cache, spline_options, add_options):
+    from .sampled_mesh import sampled_mesh
+
+    mesh = cache.get(("mesh", k))
+    if mesh is None:
+        mesh = sampled_mesh(surface.spline, surface.isovalue, k, surface.relevant)
+    return add_mesh_actor(plotter, mesh, style, spline_options)
+
+
+def _mesh_refuses(surface, style):
+    if not np.allclose(np.asarray(surface.spline.grid.direction, dtype=np.float64), np.eye(3)):
+        return "rotated lattices are drawn by the ray cast only"
+    return mesh_refuses(surface, style)
+
+
+#: The isosurface's renderers (module docstring), declared on :data:`splinevis.volume.program.PROGRAM`.
+RENDERERS = (
+    Renderer("mesh", 0, MESH_LEVELS[:8], mesh_error_px, _mesh_build, _mesh_triangles, _mesh_refuses),
+    Renderer("raycast", 10, exact=True),
+)
