@@ -163,7 +163,7 @@ class Plotter(pv.Plotter):
 
     def add_spline(self, model, style: Style | None = None, *, name: str | None = None,
                    newton_iterations: int | None = None, program_options: dict | None = None,
-                   program: str | None = None, **style_options) -> SplineActor:
+                   program: str | None = None, max_error_px: float | None = None, **style_options) -> SplineActor:
         """Add a spline model, drawn exactly per pixel by its program, beside any ordinary meshes.
 
         The model's program is found in the registry (:func:`splinevis.programs.program_for`).
@@ -185,6 +185,9 @@ class Plotter(pv.Plotter):
         program : str, optional
             A registered program by name where several draw the model's type (``"nurbs_lod"``: levels of
             detail as one mesh, instead of the per-fragment ``"nurbs"``); default: the model's program.
+        max_error_px : float, optional
+            Draw it the cheapest way its program declares whose screen-space error stays below that many
+            pixels for the current camera (:mod:`splinevis.choice`); the actor's ``renderer_choice`` says which.
 
         Returns
         -------
@@ -208,6 +211,11 @@ class Plotter(pv.Plotter):
         from .programs import get, program_for
 
         st = _style_from(style, style_options)
+        if max_error_px is not None:
+            from .choice import add_model_by_accuracy
+
+            return add_model_by_accuracy(self, model, st, max_error_px, name=name, newton_iterations=newton_iterations,
+                                         program_options=program_options, program=program)
         program = program_for(model) if program is None else get(program)
         if not isinstance(model, (program.model_type, str, os.PathLike) + tuple(program.converts)):
             raise TypeError(f"program {program.name!r} draws {program.model_type.__name__}, not {type(model).__name__}.")

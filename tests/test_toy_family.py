@@ -1,6 +1,7 @@
 """A family from the tests folder joins splinevis through the registry alone: drawn by add_spline, checked
-per pixel against its float64 twin on its hard cases, listed by the self-test, removed again. No package file
-knows it (docs/architecture.md)."""
+per pixel against its float64 twin on its hard cases, listed by the self-test, drawn the cheapest way its own
+declared renderers allow for a requested screen-space error, removed again. No package file knows it
+(docs/architecture.md)."""
 
 import numpy as np
 import pytest
@@ -127,3 +128,96 @@ def test_toy_surface_family_evaluates_per_fragment():
     unit = n / np.linalg.norm(n)
     expected = 0.5 * (unit + 1)  # normal-colour convention of lib/effects/normals.glsl (faces the viewer here)
     assert np.abs(img[drawn] - expected).max() < 2.5 / 255
+
+
+def test_toy_mesh_bound_holds_and_is_attained():
+    # toy_family/renderers.py: every point of a triangle inscribed in the sphere is within the sagitta
+    # r - sqrt(r^2 - rho^2) of the sphere, attained at the circumcentre of a triangle that contains it (the
+    # quads between two circles of latitude are cyclic: one of their two triangles holds the centre). The
+    # distances are float64 from float32 vertices (|v| = r within 5e-8 r, measured): 1e-6 r covers them.
+    from toy_family.renderers import sagitta_bounds, sphere_mesh, world_error
+
+    rng = np.random.default_rng(3)
+    model = ToySphere(2.0, (1.0, -2.0, 0.5))
+    for n in (8, 16, 32):
+        mesh = sphere_mesh(model, n)
+        tri = np.asarray(mesh.points, dtype=np.float64)[mesh.faces.reshape(-1, 4)[:, 1:]]
+        sag = sagitta_bounds(model, mesh)
+        lam = rng.dirichlet(np.ones(3), (len(tri), 64))
+        pts = np.einsum("tsi,tij->tsj", lam, tri)
+        dist = model.radius - np.linalg.norm(pts - model.center, axis=2)
+        assert (dist <= sag[:, None] + 1e-6 * model.radius).all() and (dist > -1e-6 * model.radius).all()
+        assert world_error(model, n) >= sag.max()
+        # circumcentres: the foot of the centre on each triangle's plane; inside the triangle -> attained
+        e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+        normal = np.cross(e1, e2)
+        foot = model.center + np.einsum("ti,ti->t", tri[:, 0] - model.center, normal)[:, None] * normal / (
+            np.einsum("ti,ti->t", normal, normal)[:, None])
+        gram = np.stack([np.stack([(e1 * e1).sum(1), (e1 * e2).sum(1)], 1), np.stack([(e1 * e2).sum(1), (e2 * e2).sum(1)], 1)], 1)
+        rhs = np.stack([((foot - tri[:, 0]) * e1).sum(1), ((foot - tri[:, 0]) * e2).sum(1)], 1)
+        uv = np.linalg.solve(gram, rhs[..., None])[..., 0]
+        inside = (uv >= -1e-9).all(1) & (uv.sum(1) <= 1 + 1e-9)
+        attained = (model.radius - np.linalg.norm(foot[inside] - model.center, axis=1)).max()
+        assert attained == pytest.approx(sag.max(), abs=1e-6 * model.radius)
+
+
+def _silhouette(actor_maker, camera):
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    pl.camera_position = camera
+    actor = actor_maker(pl)
+    pl.camera.clipping_range = (1.0, 10.0)
+    pl.render()
+    mask = pl.depth_buffer() < 1
+    pl.close()
+    return actor, mask
+
+
+def test_toy_declares_its_renderers_and_add_spline_chooses_among_them(toys):
+    # Plotter.add_spline(model, max_error_px=...) walks the toy's own renderers (toy_family/renderers.py): a
+    # request its mesh's proven bound meets draws the smallest such mesh; one nothing meets draws the exact
+    # ray cast, and renderer_choice says so.
+    from scipy.ndimage import binary_dilation
+
+    from toy_family.renderers import sphere_mesh
+
+    camera = [(3.0, -4.0, 2.0), (0.0, 0.0, 0.0), (0, 0, 1)]
+    mesh_actor, mesh_mask = _silhouette(lambda pl: pl.add_spline(ToySphere(), max_error_px=2.0, lights=1), camera)
+    c = mesh_actor.renderer_choice
+    assert (c.renderer, c.level, c.meets, c.chosen.proven) == ("mesh", 32, True, True), c.message
+    assert [o.level for o in c.options if o.name == "mesh"] == [8, 16, 32]
+    assert all(o.error_px > 2.0 for o in c.options if o.name == "mesh" and o.level < 32)
+    assert mesh_actor.GetMapper().GetInput().GetNumberOfCells() == sphere_mesh(ToySphere(), 32).n_cells
+    assert "considered: mesh k=8" in c.message and "raycast" in c.message
+
+    exact_actor, exact_mask = _silhouette(lambda pl: pl.add_spline(ToySphere(), max_error_px=1e-3, lights=1), camera)
+    c = exact_actor.renderer_choice
+    assert c.renderer == "raycast" and not c.meets and "nothing meets max_error_px=0.001" in c.message, c.message
+    assert exact_actor.program is RAYCAST and [o.level for o in c.options if o.name == "mesh"] == [8, 16, 32, 64, 128, 256]
+    # the pictures agree within the mesh's bound: every point of it moves at most e = 0.71 px, so a pixel
+    # covered by one silhouette is within e + sqrt(2) (the nearest covered pixel centre of a blob ~40 px
+    # across) of one covered by the other: chessboard dilation by ceil(e + 1.5) contains it
+    k = int(np.ceil(mesh_actor.renderer_choice.error_px + 1.5))
+    eight = np.ones((3, 3), bool)
+    assert exact_mask.sum() > 3000
+    assert not (mesh_mask & ~binary_dilation(exact_mask, eight, k)).any()
+    assert not (exact_mask & ~binary_dilation(mesh_mask, eight, k)).any()
+
+
+def test_a_program_without_renderers_is_drawn_by_its_own(toys):
+    # the mesh toy and the surface toy declare none: the choice draws their own program and says so (their
+    # error unknown: no float64 twin, so no request is met); the plane has no bounds: the default camera is
+    # fitted to what its program builds
+    from toy_family import SURFACE, ToyPlane
+
+    programs.register(SURFACE)
+    try:
+        for model, kind in ((ToyMeshSphere(), "mesh"), (ToyPlane(), "surface")):
+            pl = splinevis.Plotter(off_screen=True, window_size=(80, 60))
+            actor = pl.add_spline(model, max_error_px=1.0)
+            c = actor.renderer_choice
+            assert (c.renderer, c.meets) == (kind, False)
+            assert "declares no renderers: drawn by its own" in c.message and "error unknown" in c.message
+            assert (pl.depth_buffer() < 1).sum() > 300
+            pl.close()
+    finally:
+        programs.unregister(SURFACE.name)

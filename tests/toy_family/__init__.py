@@ -1,7 +1,8 @@
 """Two toy spline families defined outside the package, as a contributor would write them
 (docs/architecture.md, "How to add a family"): a ray-cast sphere with its own GLSL file, float64 twin, derived
-depth bound and hard cases, and a CPU-tessellated ("mesh" kind) sphere. Registering them touches no package
-file."""
+depth bound and hard cases, and a CPU-tessellated ("mesh" kind) sphere. The ray-cast sphere declares its own
+renderers for the choice by accuracy (``renderers.py``: a tessellation with a proven bound, and the exact ray
+cast); the others declare none. Registering them touches no package file."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ from splinevis.gl.error_bounds import U32, depth_error, model_frame_matrix, root
 from splinevis.gl.proxies import boxes
 from splinevis.gl.spec import ProgramSpec
 
+from .renderers import RENDERERS
+
 GLSL = Path(__file__).parent / "glsl"
 
 
@@ -23,6 +26,12 @@ class ToySphere:
     def __init__(self, radius=1.0, center=(0.0, 0.0, 0.0)):
         self.radius = float(radius)
         self.center = np.asarray(center, dtype=np.float64)
+
+    @property
+    def bounds(self):
+        """(xmin, xmax, ymin, ymax, zmin, zmax), what a camera is fitted to."""
+        lo, hi = self.center - self.radius, self.center + self.radius
+        return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
 
 
 def build(model, style, *, newton_iterations):
@@ -77,7 +86,8 @@ def hard_cases():
 
 
 RAYCAST = SplineProgram(name="toy_sphere", kind="raycast", model_type=ToySphere, build=build, reference=reference,
-                        depth_bound=depth_bound, hard_cases=hard_cases, description="a sphere, ray-cast")
+                        depth_bound=depth_bound, hard_cases=hard_cases, description="a sphere, ray-cast",
+                        renderers=RENDERERS)
 
 
 class ToyMeshSphere(ToySphere):
