@@ -286,8 +286,8 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     The view is the plotter's camera if it was set, else pyvista's default view fitted to the model's bounds
     (what the first render would show); the camera is then set to that view (moving it closer afterwards
     can break the request: call again or choose for the final camera). Ray-cast options (``program_options``,
-    ``program``) exclude every renderer but the program's own plain one. The actor gets ``renderer_choice`` (a
-    :class:`Choice`) and ``model``; the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
+    ``program``) exclude every renderer but the program's own plain one. The actor gets ``choice`` (a
+    :class:`Choice`; also as ``renderer_choice``) and ``model``; the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
 
     Examples
     --------
@@ -342,7 +342,7 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     actor = build(plotter, model, style, choice.level, cache, spline_options, add_options)
     cam.DeepCopy(saved)
     ren.ResetCameraClippingRange()
-    for key, value in (("renderer_choice", choice), ("model", model)):
+    for key, value in (("renderer_choice", choice), ("choice", choice), ("model", model)):
         try:
             setattr(actor, key, value)
         except AttributeError:  # a pyvista Actor takes new attributes only this way
