@@ -12,6 +12,7 @@
 #include "lib/core/table.glsl"
 #include "lib/simplex/bb_triangle.glsl"
 #include "lib/simplex/graph_patch.glsl"
+#include "lib/simplex/quartic_unrolled.glsl"
 #ifdef SV_TERRAIN_MESH
 // the mesh-guided build (proxy="mesh"): the full walk below becomes sv_surface_hit_full, the fallback of
 // lib/terrain/mesh_guided.glsl (included at the end), which defines sv_surface_hit
@@ -139,7 +140,11 @@ void sv_terrain_fill_hit(vec3 ro, vec3 rd, vec3 P0, vec3 D, float t_hit, ivec2 c
     float f;
     vec3 a;
     float dd[6];
+#ifdef SV_TERRAIN_LEGACY
     sv_tri_quartic_jet(b, l, f, a, dd);
+#else
+    sv_tri_quartic_jet_unrolled(b, l, f, a, dd);  // constant indices: the generic steps cost ~1/8 of a frame here
+#endif
     vec3 du = sv_cell_bary(vec2(1.0, 0.0), tri) - sv_cell_bary(vec2(0.0), tri);
     vec3 dv = sv_cell_bary(vec2(0.0, 1.0), tri) - sv_cell_bary(vec2(0.0), tri);
     float fx = 4.0 * dot(du, a) * sv_index_scale.x;
@@ -192,7 +197,9 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.uv = (P0.xy + t_hit * D.xy) / sv_ncells;
     return true;
 }
-#else
+#elif defined(SV_TERRAIN_LEGACY)
+// Today's walk before the rounds below (kept for the benchmarks' side-by-side timing: benchmarks/bench_profile.py):
+// the cell test inside the walk's loop body. Same hits as the default walk, bit for bit.
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.curvature = vec2(0.0);
     hit.depth = 0.0;
@@ -292,6 +299,187 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
             L += 1;
             c = c / 2;
         }
+    }
+    if (t_hit == SV_NO_HIT) return false;
+    sv_terrain_fill_hit(ro, rd, P0, D, t_hit, cell_hit, hit);
+    return true;
+}
+#else
+// The walk in rounds. llvmpipe (the renderer of machines without a GPU) runs the fragments of a SIMD group in
+// lock step: every instruction of a branch runs for the whole group, masked, whether or not a fragment takes it;
+// only a loop's further iterations are skipped when no fragment of the group needs them (the first always runs).
+// A cell test inside the walk's loop body therefore cost every group a full cell test at every walk step. Here
+// the walk runs in its own loop until each fragment stands at a candidate cell (or has left the terrain), then
+// all test their cells together, with ONE copy of the root finder for both triangles: a round per cell tested
+// (per tested cell of the group's slowest fragment), not per walk step. The hits are those of the legacy walk
+// above, bit for bit: the cell's hit is min over its triangles of ta + s (s the hit on the rebased segment),
+// and the root finder runs on the triangle that may hit first; the other one only when its segment starts before
+// that hit (then in a second round for this cell: `retry`).
+
+// Step from block c (level L, exits txy, leaving at tb) to the neighbour the ray enters, going up a level when
+// that neighbour has another parent; false when the ray leaves the terrain (or its box) instead.
+bool sv_walk_step(vec2 txy, float tb, float t_end, ivec2 stepdir, float size, inout ivec2 c, inout int L,
+                  inout float t) {
+    if (tb >= t_end) return false;
+    ivec2 parent = c / 2;
+    if (txy.x <= txy.y) c.x += stepdir.x; else c.y += stepdir.y;
+    t = tb;
+    ivec2 nb = ivec2(ceil(sv_ncells / size));
+    if (c.x < 0 || c.y < 0 || c.x >= nb.x || c.y >= nb.y) return false;
+    // Entering another parent block: go up, so empty regions are skipped at the coarsest level.
+    if (L < sv_top_level && (c / 2) != parent) {
+        L += 1;
+        c = c / 2;
+    }
+    return true;
+}
+
+// Triangle `tri` of a cell on the cell-local ray o + t d, t in [ta, tb], rebased to the segment's start as in
+// sv_triangle_hit: k, t0, t1, c of sv_graph_patch_prepare (t0, t1 relative to ta).
+int sv_triangle_prepare(float b[15], int tri, vec3 o, vec3 d, float ta, float tb, float margin, out float t0,
+                        out float t1, out float c[5]) {
+    vec3 start = o + ta * d;
+    vec3 lo = sv_cell_bary(start.xy, tri);
+    vec3 ld = sv_cell_bary(d.xy, tri) - sv_cell_bary(vec2(0.0), tri);
+    return sv_graph_patch_prepare(b, lo, ld, start.z, d.z, 0.0, tb - ta, margin, t0, t1, c);
+}
+
+bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
+    hit.curvature = vec2(0.0);
+    hit.depth = 0.0;
+    // The ray in index space: P(t) = P0 + t D (t unchanged).
+    vec3 P0 = vec3(sv_index_scale * ro.xy + sv_index_shift, ro.z);
+    vec3 D = vec3(sv_index_scale * rd.xy, rd.z);
+    float t, t_end;
+    if (!sv_clip_to_box(P0, D, tmin, t, t_end)) return false;
+    // Start in the top-level block holding the entry point (see the legacy walk above).
+    int L = sv_top_level;
+    ivec2 c = clamp(ivec2(floor((P0.xy + t * D.xy) / float(1 << L))), ivec2(0),
+                    ivec2(ceil(sv_ncells / float(1 << L))) - ivec2(1));
+    ivec2 stepdir = ivec2(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1);
+    float t_hit = SV_NO_HIT;
+    ivec2 cell_hit = ivec2(0);
+    int s = 0;
+    // the cell under test: its exit tb, bounds mm and the rounding zerr of the ray's heights; in a retry round the
+    // triangle whose root is known and the hit so far (rebased)
+    float tb = t;
+    vec2 mm = vec2(0.0);
+    float zerr = 0.0;
+    bool retry = false;
+    int solved = -1;
+    float best = SV_NO_HIT;
+    for (int round = 0; round < 2 * sv_max_steps; ++round) {
+        if (!retry) {
+            // the walk (the legacy loop without its cell test), to the next cell whose bounds the ray meets
+            bool cand = false;
+            for (; s < sv_max_steps; ++s) {
+#ifdef SV_DEBUG_COUNTERS
+                sv_count_traversal += 1;
+#endif
+                float size = float(1 << L);
+                vec2 lo = vec2(c) * size;
+                vec2 hi = min(lo + vec2(size), sv_ncells);
+                vec2 txy = sv_rect_exit(P0, D, lo, hi);
+                tb = min(min(txy.x, txy.y), t_end);
+                mm = sv_block_minmax(L, c);
+                float za = P0.z + t * D.z;
+                float zb = P0.z + tb * D.z;
+                // the rounding of the ray's heights (legacy walk)
+                zerr = 2.384185791015625e-07 * (abs(P0.z) + max(abs(t), abs(tb)) * abs(D.z));
+                if (max(za, zb) + zerr >= mm.x && min(za, zb) - zerr <= mm.y) {
+                    if (L > 0) {
+                        // Descend to the child holding P(t); clamp to c's children (P(t) may sit on a border).
+                        L -= 1;
+                        vec2 p = P0.xy + t * D.xy;
+                        ivec2 child = ivec2(floor(p / float(1 << L)));
+                        c = clamp(child, 2 * c, 2 * c + ivec2(1));
+                        continue;
+                    }
+                    cand = true;
+                    ++s;
+                    break;
+                }
+                if (!sv_walk_step(txy, tb, t_end, stepdir, size, c, L, t)) {
+                    s = sv_max_steps;
+                    break;
+                }
+            }
+            if (!cand) break;
+#ifdef SV_DEBUG_TRAVERSAL_ONLY
+            // traversal only (debug="traversal"): the first candidate cell is the hit, at the ray's entry
+            t_hit = t;
+            cell_hit = c;
+            break;
+#endif
+#ifdef SV_DEBUG_COUNTERS
+            sv_count_cells += 1;
+#endif
+            solved = -1;
+            best = SV_NO_HIT;
+        }
+#ifndef SV_DEBUG_TRAVERSAL_ONLY
+        float b0[15];
+        float b1[15];
+        sv_load_cell(c, b0, b1);
+        vec3 o = vec3(P0.xy - vec2(c), P0.z);
+        // the cell's segment, widened by the margin and cut to the slab (as in the legacy walk)
+        float margin = max(SV_CELL_MARGIN, 4.76837158203125e-07 * (max(abs(P0.x), abs(P0.y))
+                                                                  + abs(t) * max(abs(D.x), abs(D.y))));
+        float dt_margin = margin / max(max(abs(D.x), abs(D.y)), 1e-30);
+        float ta_c = t - dt_margin;
+        float tb_c = tb + dt_margin;
+        if (abs(D.z) > 0.0) {
+            float zpad = (mm.y - mm.x) + zerr + 1.0e-6 * (abs(mm.x) + abs(mm.y)) + 1.0e-30;
+            float tz0 = (mm.x - zpad - P0.z) / D.z;
+            float tz1 = (mm.y + zpad - P0.z) / D.z;
+            ta_c = max(ta_c, min(tz0, tz1));
+            tb_c = min(tb_c, max(tz0, tz1));
+        }
+        float u0, u1, v0, v1;
+        float c0[5];
+        float c1[5];
+        int k0 = sv_triangle_prepare(b0, 0, o, D, ta_c, tb_c, margin, u0, u1, c0);
+        int k1 = sv_triangle_prepare(b1, 1, o, D, ta_c, tb_c, margin, v0, v1, c1);
+        if (k0 == SV_PATCH_START) best = min(best, u0);
+        if (k1 == SV_PATCH_START) best = min(best, v0);
+        // A root found on [t0, t1] is mix(t0, t1, r) >= t0 - (rounding), r in [0, 1]: a triangle whose segment
+        // starts after the hit so far by more than that cannot give an earlier hit and is not solved.
+        float lb0 = u0 - 4.76837158203125e-07 * (abs(u0) + abs(u1));
+        float lb1 = v0 - 4.76837158203125e-07 * (abs(v0) + abs(v1));
+        bool open0 = k0 == SV_PATCH_ROOT && solved != 0 && lb0 < best;
+        bool open1 = k1 == SV_PATCH_ROOT && solved != 1 && lb1 < best;
+#ifndef SV_DEBUG_NO_ROOTS
+        if (open0 || open1) {
+            // one root finder for both triangles: the one whose segment starts first
+            bool first0 = open0 && (!open1 || u0 <= v0);
+            float cr[5];
+            for (int q = 0; q < 5; ++q) cr[q] = first0 ? c0[q] : c1[q];
+            float r0 = first0 ? u0 : v0;
+            float r1 = first0 ? u1 : v1;
+#ifdef SV_DEBUG_COUNTERS
+            sv_count_root_calls += 1;
+#endif
+            float r = sv_first_root(cr, 4, sv_newton_iterations);
+            if (r >= 0.0) best = min(best, mix(r0, r1, r));
+            solved = first0 ? 0 : 1;
+            bool other = first0 ? (open1 && lb1 < best) : (open0 && lb0 < best);
+            if (other) {
+                retry = true;
+                continue;
+            }
+        }
+#endif
+        retry = false;
+        if (best < SV_NO_HIT) {
+            t_hit = ta_c + best;
+            cell_hit = c;
+            break;
+        }
+        // no hit in this cell: step past it (level 0, as at the end of the legacy walk's body)
+        vec2 lo = vec2(c);
+        vec2 txy = sv_rect_exit(P0, D, lo, min(lo + vec2(1.0), sv_ncells));
+        if (!sv_walk_step(txy, tb, t_end, stepdir, 1.0, c, L, t)) break;
+#endif
     }
     if (t_hit == SV_NO_HIT) return false;
     sv_terrain_fill_hit(ro, rd, P0, D, t_hit, cell_hit, hit);

@@ -17,13 +17,22 @@
 #include "lib/core/roots.glsl"
 
 
-float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz, float ta, float tb, float margin,
-                         int iterations) {
-    float t0 = ta;
-    float t1 = tb;
+// Steps 1-4 without the root finder: SV_PATCH_MISS (no root on the segment), SV_PATCH_START (a hit at t0) or
+// SV_PATCH_ROOT (the first root of c, the restricted polynomial on [t0, t1], is the hit, if it has one). A
+// caller that runs the root finder itself (the terrain's walk, one copy for both triangles of a cell) gets the
+// same hits as sv_graph_patch_hit.
+const int SV_PATCH_MISS = 0;
+const int SV_PATCH_START = 1;
+const int SV_PATCH_ROOT = 2;
+
+int sv_graph_patch_prepare(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz, float ta, float tb, float margin,
+                           out float t0, out float t1, out float c[5]) {
+    t0 = ta;
+    t1 = tb;
+    for (int k = 0; k < 5; ++k) c[k] = 0.0;
     for (int k = 0; k < 3; ++k) {
         if (abs(lam_d[k]) < 1e-30) {
-            if (lam_o[k] < -margin) return SV_NO_HIT;
+            if (lam_o[k] < -margin) return SV_PATCH_MISS;
         } else {
             float tc = (-margin - lam_o[k]) / lam_d[k];
             if (lam_d[k] > 0.0) t0 = max(t0, tc); else t1 = min(t1, tc);
@@ -36,15 +45,14 @@ float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz
     zlo -= zpad;
     zhi += zpad;
     if (abs(dz) < 1e-30) {
-        if (oz < zlo || oz > zhi) return SV_NO_HIT;
+        if (oz < zlo || oz > zhi) return SV_PATCH_MISS;
     } else {
         float za = (zlo - oz) / dz;
         float zb = (zhi - oz) / dz;
         t0 = max(t0, min(za, zb));
         t1 = min(t1, max(za, zb));
     }
-    if (!(t0 <= t1)) return SV_NO_HIT;
-    float c[5];
+    if (!(t0 <= t1)) return SV_PATCH_MISS;
     sv_restrict_quartic_tri(b, lam_o + t0 * lam_d, lam_o + t1 * lam_d, c);
     float z0 = oz + t0 * dz;
     float z1 = oz + t1 * dz;
@@ -56,16 +64,32 @@ float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz
     float L = 0.0;
     for (int k = 0; k < 3; ++k) L = max(L, abs(lam_o[k]) + max(abs(t0), abs(t1)) * abs(lam_d[k]));
     float eps_c = 5.9604644775390625e-08 * (32.0 * (max(abs(zlo), abs(zhi)) + max(abs(z0), abs(z1))) + 16.0 * L * (zhi - zlo));
-    if (abs(c[0]) <= eps_c) return t0;
+    if (abs(c[0]) <= eps_c) return SV_PATCH_START;
     float cmin = min(min(min(c[0], c[1]), min(c[2], c[3])), c[4]);
     float cmax = max(max(max(c[0], c[1]), max(c[2], c[3])), c[4]);
-    if (cmin > 0.0 || cmax < 0.0) return SV_NO_HIT;
+    if (cmin > 0.0 || cmax < 0.0) return SV_PATCH_MISS;
 #ifdef SV_DEBUG_NO_ROOTS
-    return t0;  // debug build without the root finder (terrain option debug="restrict"): the segment's start
+    return SV_PATCH_START;  // debug build without the root finder (terrain option debug="restrict"): the segment's start
 #endif
+    return SV_PATCH_ROOT;
+}
+
+// The hit of a prepared segment (sv_graph_patch_prepare's result k, t0, t1, c): t0, the first root, or SV_NO_HIT.
+float sv_graph_patch_finish(int k, float t0, float t1, float c[5], int iterations) {
+    if (k == SV_PATCH_MISS) return SV_NO_HIT;
+    if (k == SV_PATCH_START) return t0;
 #ifdef SV_DEBUG_COUNTERS
     sv_count_root_calls += 1;
 #endif
     float s = sv_first_root(c, 4, iterations);
     return s < 0.0 ? SV_NO_HIT : mix(t0, t1, s);
+}
+
+float sv_graph_patch_hit(float b[15], vec3 lam_o, vec3 lam_d, float oz, float dz, float ta, float tb, float margin,
+                         int iterations) {
+    float t0;
+    float t1;
+    float c[5];
+    int k = sv_graph_patch_prepare(b, lam_o, lam_d, oz, dz, ta, tb, margin, t0, t1, c);
+    return sv_graph_patch_finish(k, t0, t1, c, iterations);
 }
