@@ -22,12 +22,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .fit import fit_geometry_image
-from .measure import surface_distance
+from .measure import reversed_normals, surface_distance
 from .model import GeometryImage
 from .regularize import SIGMA_CELLS, smooth_samples, smoothing_steps
 
 __all__ = ["BuildReport", "geometry_image_from_mesh", "limit_mesh_arrays", "folded_fraction", "fold_counts",
-           "FOLDED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF", "auto_oversample"]
+           "FOLDED_WARNING", "REVERSED_WARNING", "FOLD_LEVEL", "AUTO_SIZES", "AUTO_HAUSDORFF", "auto_oversample"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,8 +63,10 @@ class BuildReport:
         The check's count (:mod:`.judge`), measured the same way: ``{"level", "triangles", "folded",
         "fraction", "at_cut"}`` of the limit mesh :data:`FOLD_LEVEL` levels down (:func:`fold_counts`:
         neighbouring limit points whose normals and triangle turn apart, the triangles at the four cut vertices
-        counted apart in ``at_cut``); empty when not measured. :data:`FOLDED_WARNING` applies to its
-        ``fraction``.
+        counted apart in ``at_cut``), and ``"reversed"``, the share of level-``levels_finer`` limit points whose
+        normal points into the mesh (:func:`.measure.reversed_normals`); empty when not measured.
+        :data:`FOLDED_WARNING` applies to ``fraction``, :data:`REVERSED_WARNING` to ``reversed``; with
+        ``fairness="auto"``, ``"fairness_tried"`` and ``"reversed_tried"`` list each weight's figures.
     repairs : tuple of str
         What was done to the input to make it one closed triangle mesh (:func:`.repair.prepare_mesh`: welding,
         triangulating, dropping unused points); each also a warning.
@@ -95,6 +97,11 @@ class BuildReport:
 #: Above this fraction of folded limit triangles on level :data:`FOLD_LEVEL` (the check's count, away from the
 #: cut vertices), :func:`geometry_image_from_mesh` warns and the check fails (:mod:`.judge` says why 1e-4).
 FOLDED_WARNING = 1e-4
+
+#: Above this fraction of limit points (level ``levels_finer``) whose normal points into the mesh (more than 120
+#: degrees from the nearest input triangle's, :func:`.measure.reversed_normals`), the image is inside out over a
+#: patch several pixels wide: ``fairness="auto"`` smooths further, the build warns and the check fails.
+REVERSED_WARNING = 1e-3
 
 #: The subdivision level folds are counted on, by the build and the check alike: the check draws level 3 and
 #: measures one level finer (:mod:`.judge`).
@@ -183,7 +190,7 @@ AUTO_SIZES = (33, 65, 129, 257)
 AUTO_HAUSDORFF = 0.005
 
 #: Fairness weights ``fairness="auto"`` tries in turn while the image folds (more than :data:`FOLDED_WARNING` of
-#: its level-:data:`FOLD_LEVEL` triangles), each ``sqrt(10)`` times the last, and the distance (share of the
+#: its level-:data:`FOLD_LEVEL` triangles) or is inside out (more than :data:`REVERSED_WARNING`), each ``sqrt(10)`` times the last, and the distance (share of the
 #: diagonal) a stronger weight may not exceed. Why: the fairness term smooths at the scale ``lambda^(1/4) h / 2``
 #: (:mod:`.fit`), so each step widens the smoothing by ``10^(1/8)``, 33 %, and the ripples where the map
 #: compresses the mesh (the folds) fade; the surface moves from the mesh as it smooths. Measured at n = 257
@@ -231,6 +238,16 @@ def _next_size(index: int, sizes, tried: dict) -> int:
     return min(index + max(steps, 1), len(sizes) - 1)
 
 
+def _badness(folds: dict) -> float:
+    """How far the image is past the fold and inside-out thresholds: the larger of the folded fraction over
+    :data:`FOLDED_WARNING` and the reversed fraction over :data:`REVERSED_WARNING` (at most 1: neither exceeded).
+
+    >>> _badness({"fraction": 5e-5, "reversed": 2e-3})
+    2.0
+    """
+    return max(folds["fraction"] / FOLDED_WARNING, folds.get("reversed", 0.0) / REVERSED_WARNING)
+
+
 def _fold_measure(image, n: int) -> dict:
     """The check's fold count (:func:`fold_counts` on level :data:`FOLD_LEVEL`) of ``image``."""
     from .subdivision import subdivide
@@ -261,9 +278,11 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     fairness : float or "auto"
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
         leaves in the normals (measured in the geometry-image study) at a small cost in distance. ``"auto"``
-        (default): 0.1 (sizes are chosen with it), then the next of :data:`AUTO_FAIRNESS` while the image folds,
-        as long as the surface stays within :data:`AUTO_FAIRNESS_HAUSDORFF` of the mesh; the fit with the fewest
-        folds is kept (``folds["fairness_tried"]`` lists each weight's fold fraction and distance).
+        (default): 0.1 (sizes are chosen with it), then the next of :data:`AUTO_FAIRNESS` while the image folds
+        or is inside out (:func:`_badness` above 1), as long as the surface stays within
+        :data:`AUTO_FAIRNESS_HAUSDORFF` of the mesh; the fit least past those thresholds is kept
+        (``folds["fairness_tried"]`` lists each weight's fold fraction and distance, ``folds["reversed_tried"]``
+        its inside-out fraction).
     oversample : int or "auto"
         Mesh samples per control point and direction; ``"auto"`` (:func:`auto_oversample`) as few as resolve
         both the image and the mesh.
@@ -382,7 +401,8 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         if measure:
             t0 = time.perf_counter()
             P, N, F = limit_mesh_arrays(fit.image, levels_finer)
-            distance = surface_distance(P, F, smap.points, smap.faces)
+            distance = surface_distance(P, F, smap.points, smap.faces, closest=True)
+            reversed_ = reversed_normals(N, distance.pop("closest_face"), smap.points, smap.faces)
             folded = folded_fraction(P, N, F)
             seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
             tried[int(n)] = float(distance["hausdorff"])
@@ -394,36 +414,42 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     folds = {}
     if measure:
         t0 = time.perf_counter()
-        folds = _fold_measure(fit.image, n)
+        folds = dict(_fold_measure(fit.image, n), reversed=reversed_["reversed_fraction"])
         seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
         if auto_fairness:
             tried_f = {fairness: (folds["fraction"], float(distance["hausdorff"]))}
+            reversed_tried = {fairness: folds["reversed"]}
             for stronger in AUTO_FAIRNESS[1:]:
-                if folds["fraction"] <= FOLDED_WARNING:
+                if _badness(folds) <= 1.0:
                     break
                 t0 = time.perf_counter()
                 fit2 = fit_geometry_image(None, n, fairness=stronger, oversample=k, samples=samples)
                 seconds["fit"] += time.perf_counter() - t0
                 t0 = time.perf_counter()
                 P, N, F = limit_mesh_arrays(fit2.image, levels_finer)
-                distance2 = surface_distance(P, F, smap.points, smap.faces)
+                distance2 = surface_distance(P, F, smap.points, smap.faces, closest=True)
+                closest = distance2.pop("closest_face")
                 if distance2["hausdorff"] > AUTO_FAIRNESS_HAUSDORFF:  # smoothed too far from the mesh: keep the
                     seconds["measure"] += time.perf_counter() - t0  # last fit that was close enough (its folds
                     tried_f[stronger] = (float("nan"), float(distance2["hausdorff"]))  # are not counted: no use)
                     break
-                folds2 = _fold_measure(fit2.image, n)
+                folds2 = dict(_fold_measure(fit2.image, n),
+                              reversed=reversed_normals(N, closest, smap.points, smap.faces)["reversed_fraction"])
                 seconds["measure"] += time.perf_counter() - t0
                 tried_f[stronger] = (folds2["fraction"], float(distance2["hausdorff"]))
-                if folds2["folded"] < folds["folded"]:
+                reversed_tried[stronger] = folds2["reversed"]
+                if _badness(folds2) < _badness(folds):
                     fit, folds, fairness = fit2, folds2, stronger
                     distance = dict(distance2, **({"sizes_tried": tried} if len(sizes) > 1 else {}))
                     folded = folded_fraction(P, N, F)
             folds["fairness_tried"] = tried_f
-        if folds["fraction"] > FOLDED_WARNING:
+            folds["reversed_tried"] = reversed_tried
+        if _badness(folds) > 1.0:
             import warnings
 
             warnings.warn(f"the geometry image of {name} folds over in {100 * folds['fraction']:.2g}% of its limit "
-                          f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}): the "
+                          f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}) and is "
+                          f"inside out at {100 * folds['reversed']:.2g}% of its limit points: the "
                           f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
                           f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; "
                           + ("fairness tried (folds, distance): " + ", ".join(

@@ -74,7 +74,7 @@ from pathlib import Path
 import numpy as np
 
 from ..check.judge import FamilyJudge, Finding
-from .build import FOLDED_WARNING
+from .build import FOLDED_WARNING, REVERSED_WARNING
 
 __all__ = ["JUDGE"]
 
@@ -82,7 +82,7 @@ __all__ = ["JUDGE"]
 DEFAULTS = {"n": "auto", "fairness": "auto", "level": 3.0, "measure_level": None}
 
 #: Verdict thresholds (module docstring): distances in units of the input's bounding-box diagonal.
-THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FOLDED_WARNING, "reversed_fail": 1e-3}
+THRESHOLDS = {"hausdorff_warn": 0.005, "hausdorff_fail": 0.03, "folded_fail": FOLDED_WARNING, "reversed_fail": REVERSED_WARNING}
 
 #: The level whose limit points the reversed normals are counted on (module docstring).
 REVERSED_LEVEL = 2
@@ -220,21 +220,15 @@ def _reversed(P, N, M, level, V, F) -> dict:
     import igl
 
     from .image import cut_vertices
+    from .measure import reversed_normals
 
-    face_normal = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
-    adjacent, _ = igl.triangle_triangle_adjacency(F)
-    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
     step = 1 << max(level - REVERSED_LEVEL, 0)
     grid = np.zeros((M, M), bool)
     grid[::step, ::step] = True
     grid.ravel()[cut_vertices(M) @ np.array([M, 1])] = False
     idx = np.flatnonzero(grid.ravel())
     _, closest, _ = igl.point_mesh_squared_distance(np.ascontiguousarray(P[idx]), V, F)
-    judged = ~folds_itself[closest]
-    against = judged & (np.einsum("ij,ij->i", N[idx], face_normal[closest]) < -0.5)
-    return {"reversed_points": int(against.sum()), "reversed_fraction": float(against.sum() / max(judged.sum(), 1)),
-            "reversed_grid_points": int(judged.sum()), "input_folded_faces": int(folds_itself.sum())}
+    return reversed_normals(N[idx], closest, V, F)
 
 
 def _pixels(fraction: float) -> str:

@@ -15,14 +15,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["surface_distance", "normal_angles"]
+__all__ = ["surface_distance", "normal_angles", "reversed_normals"]
 
 
 def _samples(V, F):
     return np.vstack([V, V[F].mean(axis=1)])
 
 
-def surface_distance(V, F, V_ref, F_ref) -> dict:
+def surface_distance(V, F, V_ref, F_ref, *, closest: bool = False) -> dict:
     """Two-sided distance between the triangle meshes ``(V, F)`` and ``(V_ref, F_ref)`` in units of the reference's
     bounding-box diagonal (module docstring).
 
@@ -30,7 +30,8 @@ def surface_distance(V, F, V_ref, F_ref) -> dict:
     -------
     dict
         ``hausdorff`` (symmetric), ``to_reference`` (largest distance of ``(V, F)``'s samples to the reference),
-        ``from_reference`` (the other way), ``rms`` (both sample sets), ``diagonal`` (the unit).
+        ``from_reference`` (the other way), ``rms`` (both sample sets), ``diagonal`` (the unit); with
+        ``closest``, also ``closest_face``: the reference triangle nearest to each vertex of ``(V, F)``.
 
     Examples
     --------
@@ -48,11 +49,43 @@ def surface_distance(V, F, V_ref, F_ref) -> dict:
     diagonal = float(np.linalg.norm(V_ref.max(axis=0) - V_ref.min(axis=0)))
     if not diagonal > 0:
         raise ValueError("the reference mesh has a zero bounding box: nothing to measure distances in.")
-    a = np.sqrt(igl.point_mesh_squared_distance(_samples(V, F), V_ref, F_ref)[0]) / diagonal
+    d2, face, _ = igl.point_mesh_squared_distance(_samples(V, F), V_ref, F_ref)
+    a = np.sqrt(d2) / diagonal
     b = np.sqrt(igl.point_mesh_squared_distance(_samples(V_ref, F_ref), V, F)[0]) / diagonal
     both = np.concatenate([a, b])
-    return {"hausdorff": float(max(a.max(), b.max())), "to_reference": float(a.max()),
-            "from_reference": float(b.max()), "rms": float(np.sqrt((both ** 2).mean())), "diagonal": diagonal}
+    out = {"hausdorff": float(max(a.max(), b.max())), "to_reference": float(a.max()),
+           "from_reference": float(b.max()), "rms": float(np.sqrt((both ** 2).mean())), "diagonal": diagonal}
+    if closest:
+        out["closest_face"] = np.asarray(face[:len(V)], dtype=np.int64)
+    return out
+
+
+def reversed_normals(normals, closest_face, V_ref, F_ref) -> dict:
+    """Points of a smooth surface whose unit ``normals`` are more than 120 degrees from the outward normal of the
+    reference triangle closest to them (``closest_face``), where the reference itself does not fold (no
+    neighbour of that triangle faces more than 120 degrees away from it): the surface is inside out there
+    (:mod:`.judge` module docstring). Returns ``reversed_points``, ``reversed_fraction`` (of the points judged),
+    ``reversed_grid_points`` (judged) and ``input_folded_faces``.
+
+    >>> V = np.array([[1.0, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]])  # a regular tetrahedron
+    >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])  # outward: face 0 faces (1, 1, -1)
+    >>> r = reversed_normals([[1.0, 1, -1], [-1.0, -1, 1]], np.array([0, 0]), V, F)
+    >>> r["reversed_points"], r["reversed_fraction"], r["input_folded_faces"]
+    (1, 0.5, 0)
+    """
+    import igl
+
+    V_ref = np.asarray(V_ref, dtype=np.float64)
+    F_ref = np.asarray(F_ref, dtype=np.int64)
+    face_normal = np.cross(V_ref[F_ref[:, 1]] - V_ref[F_ref[:, 0]], V_ref[F_ref[:, 2]] - V_ref[F_ref[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    adjacent, _ = igl.triangle_triangle_adjacency(F_ref)
+    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    N = np.asarray(normals, dtype=np.float64)
+    judged = ~folds_itself[closest_face]
+    against = judged & (np.einsum("ij,ij->i", N, face_normal[closest_face]) < -0.5)
+    return {"reversed_points": int(against.sum()), "reversed_fraction": float(against.sum() / max(judged.sum(), 1)),
+            "reversed_grid_points": int(judged.sum()), "input_folded_faces": int(folds_itself.sum())}
 
 
 def normal_angles(normals, exact) -> dict:
