@@ -231,6 +231,86 @@ float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin,
     return t_best;
 }
 
+#ifndef SV_VOLUME_LEGACY
+// Rank of tetrahedron t among the cube's relevant ones (mask bits below t), without GLSL 4's bitCount.
+int sv_bits_below(int mask, int t) {
+    int x = mask & ((1 << t) - 1);
+    x = x - ((x >> 1) & 0x55555555);
+    x = (x & 0x33333333) + ((x >> 2) & 0x33333333);
+    x = (x + (x >> 4)) & 0x0F0F0F0F;
+    return (x * 0x01010101) >> 24;
+}
+
+// sv_cube_first_hit with the same result, bit for bit, at a cost per tetrahedron the ray crosses. llvmpipe runs
+// a loop body for the whole SIMD group, masked, as often as its slowest fragment needs: the 24 iterations of
+// the loop above cost 24 full tetrahedron tests each (clip, coefficients, restriction, root). Here the cheap
+// clip of all 24 finds the candidates (relevant, segment not empty), and the loop runs once per candidate, in
+// increasing t as above (ties in t keep the lowest tetrahedron, as above).
+float sv_cube_first_hit_candidates(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin, float f[SV_CUBE_VALUES],
+                                   out int tet_best, out int rank_best) {
+    float t_best = SV_NO_HIT;
+    tet_best = -1;
+    rank_best = 0;
+    int cand = 0;
+    for (int t = 0; t < 24; ++t) {
+        if (((mask >> t) & 1) == 0) continue;
+        vec4 lo;
+        vec4 ld;
+        for (int i = 0; i < 4; ++i) {
+            vec4 m = SV_TET_BARY[4 * t + i];
+            lo[i] = dot(m.xyz, P0) + m.w;
+            ld[i] = dot(m.xyz, D);
+        }
+        float ta = tmin;
+        float tb = 3.0e38;
+        bool empty = false;
+        for (int i = 0; i < 4; ++i) {
+            float lim = -(i == 0 ? sv_cube_margin : sv_inner_margin) - lo[i];
+            if (ld[i] > 0.0) ta = max(ta, lim / ld[i]);
+            else if (ld[i] < 0.0) tb = min(tb, lim / ld[i]);
+            else if (lim > 0.0) empty = true;
+        }
+        if (!empty && ta <= tb) cand |= 1 << t;
+    }
+    for (int k = 0; k < 24; ++k) {
+        if (cand == 0) break;
+        int low = cand & (-cand);
+        cand ^= low;
+        int t = int(log2(float(low)) + 0.5);  // low = 2^t exactly (t < 24)
+        vec4 lo;
+        vec4 ld;
+        for (int i = 0; i < 4; ++i) {
+            vec4 m = SV_TET_BARY[4 * t + i];
+            lo[i] = dot(m.xyz, P0) + m.w;
+            ld[i] = dot(m.xyz, D);
+        }
+        float ta = tmin;
+        float tb = 3.0e38;
+        for (int i = 0; i < 4; ++i) {
+            float lim = -(i == 0 ? sv_cube_margin : sv_inner_margin) - lo[i];
+            if (ld[i] > 0.0) ta = max(ta, lim / ld[i]);
+            else if (ld[i] < 0.0) tb = min(tb, lim / ld[i]);
+        }
+        if (ta >= t_best) continue;
+        int rank = sv_bits_below(mask, t);
+        float b[SV_VOL_NCOEF];
+        sv_load_tet(t, row + rank, f, b);
+        float cc[5];
+        sv_restrict(b, lo + ta * ld, lo + tb * ld, cc);
+        for (int q = 0; q <= SV_VOL_DEGREE; ++q) cc[q] -= sv_iso_shifted;
+        float s = sv_first_root_deg(cc);
+        if (s < 0.0) continue;
+        float th = ta + s * (tb - ta);
+        if (th < t_best) {
+            t_best = th;
+            tet_best = t;
+            rank_best = rank;
+        }
+    }
+    return t_best;
+}
+#endif
+
 #ifdef SV_VOLUME_BLOCKS
 // Per-cube masks and table rows of the drawn blocks (sampler sv_volume_mask, one texel per cube, block after
 // block, x fastest inside a block): .r = mask (24 bits, exact in float32), .g/.b = first table row as
@@ -238,6 +318,18 @@ float sv_cube_first_hit(ivec3 c, int mask, int row, vec3 P0, vec3 D, float tmin,
 vec4 sv_cube_info(int block, ivec3 a) {
     int k = (block * sv_block_size + a.z) * sv_block_size * sv_block_size + a.y * sv_block_size + a.x;
     return sv_table_texel(sv_volume_mask, k);
+}
+#endif
+
+#if defined(SV_VOLUME_BLOCKS) && !defined(SV_VOLUME_LEGACY)
+// One DDA step from cube a of the block (exits texit, leaving at tb) to the cube the ray enters; false when it
+// leaves the block (or its segment [t0, t1]).
+bool sv_block_step(vec3 texit, float tb, float t1, ivec3 stepdir, ivec3 iext, inout ivec3 a) {
+    if (tb >= t1) return false;
+    if (texit.x <= texit.y && texit.x <= texit.z) a.x += stepdir.x;
+    else if (texit.y <= texit.z) a.y += stepdir.y;
+    else a.z += stepdir.z;
+    return !(any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, iext)));
 }
 #endif
 
@@ -274,6 +366,7 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     // start in the cube holding the entry point, nudged inside along the ray
     ivec3 a = clamp(ivec3(floor(Pb + (t0 + 1e-4 * (t1 - t0)) * D)), ivec3(0), iext - ivec3(1));
     ivec3 stepdir = ivec3(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1, D.z > 0.0 ? 1 : -1);
+#ifdef SV_VOLUME_LEGACY
     for (int s = 0; s < 3 * SV_MAX_BLOCK; ++s) {
         vec3 lo = vec3(a);
         vec3 texit;
@@ -311,6 +404,53 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
         else a.z += stepdir.z;
         if (any(lessThan(a, ivec3(0))) || any(greaterThanEqual(a, iext))) break;
     }
+#else
+    // Rounds (as the terrain's walk, glsl/programs/terrain.glsl): the DDA runs in its own loop to the next cube
+    // holding relevant tetrahedra, then that cube is tested; a cube test per round, not per cube crossed.
+    int steps = 0;
+    for (int round = 0; round < 3 * SV_MAX_BLOCK; ++round) {
+        bool found = false;
+        vec3 texit = vec3(0.0);
+        float tb = 0.0;
+        vec4 info = vec4(0.0);
+        for (; steps < 3 * SV_MAX_BLOCK; ++steps) {
+            vec3 lo = vec3(a);
+            for (int k = 0; k < 3; ++k) {
+                texit[k] = abs(D[k]) < 1e-30 ? 3.0e38 : ((D[k] > 0.0 ? lo[k] + 1.0 : lo[k]) - Pb[k]) / D[k];
+            }
+            tb = min(min(texit.x, texit.y), texit.z);
+            info = sv_cube_info(block, a);
+            if (int(info.r) != 0) {
+                found = true;
+                ++steps;
+                break;
+            }
+            if (!sv_block_step(texit, tb, t1, stepdir, iext, a)) {
+                steps = 3 * SV_MAX_BLOCK;
+                break;
+            }
+        }
+        if (!found) break;
+        ivec3 cc = b0 + a;
+        int mask = int(info.r);
+        int crow = 4096 * int(info.g) + int(info.b);
+        vec3 Pc = Pb - vec3(a);
+        sv_load_cube(cc, crow, f);
+        int tb_tet;
+        int tb_rank;
+        float th = sv_cube_first_hit_candidates(cc, mask, crow, Pc, D, tmin, f, tb_tet, tb_rank);
+        if (th < SV_NO_HIT) {
+            t_best = th;
+            tet_best = tb_tet;
+            rank_best = tb_rank;
+            row = crow;
+            c = cc;
+            P0 = Pc;
+            break;
+        }
+        if (!sv_block_step(texit, tb, t1, stepdir, iext, a)) break;
+    }
+#endif
     if (tet_best < 0) return false;
 #else
     c = ivec3(sv_cubeVSOut.xyz + 0.5);
@@ -320,7 +460,11 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     // proxy's corners).
     P0 = sv_localVSOut;
     sv_load_cube(c, row, f);
+#ifdef SV_VOLUME_LEGACY
     t_best = sv_cube_first_hit(c, mask, row, P0, D, tmin, f, tet_best, rank_best);
+#else
+    t_best = sv_cube_first_hit_candidates(c, mask, row, P0, D, tmin, f, tet_best, rank_best);
+#endif
     if (tet_best < 0) return false;
 #endif
 
