@@ -23,7 +23,7 @@ def test_samples_stay_on_the_mesh_and_identified_samples_stay_identical():
     M = 65
     face, bary = locate(smap, octahedral_to_sphere(image_uv(M)).reshape(-1, 3))
     X = np.einsum("ni,nij->nj", bary, smap.points[smap.faces[face]]).reshape(M, M, 3)
-    Y, kept = smooth_samples(smap.points, smap.faces, smap.sphere, X, face, smoothing_steps(2))
+    Y, kept = smooth_samples(smap.points, smap.faces, X, face, smoothing_steps(2))
     diag = np.linalg.norm(np.ptp(smap.points, axis=0))
     d2, _, _ = igl.point_mesh_squared_distance(Y.reshape(-1, 3), smap.points, smap.faces)
     # closest points of libigl: on the mesh up to the rounding of a point-in-triangle computation (~1e-15 diag)

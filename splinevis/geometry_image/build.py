@@ -389,8 +389,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         seconds["sample"] = seconds.get("sample", 0.0) + time.perf_counter() - t0
         if smoothing > 0:
             t0 = time.perf_counter()
-            samples, _ = smooth_samples(smap.points, smap.faces, smap.sphere, samples, face,
-                                        smoothing_steps(k, smoothing))
+            samples, _ = smooth_samples(smap.points, smap.faces, samples, face, smoothing_steps(k, smoothing))
             seconds["smooth"] = seconds.get("smooth", 0.0) + time.perf_counter() - t0
 
         t0 = time.perf_counter()
