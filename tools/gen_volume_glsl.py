@@ -4,6 +4,8 @@ Writes, under glsl/lib/:
 
 * ``type6/partition.glsl`` -- the 24 barycentric matrices of the type-6 split (splinevis.volume.partition) as a
   constant table: ``lam_i = dot(SV_TET_BARY[4 t + i], vec4(local, 1))``;
+* ``type6/tet_clip.glsl`` -- the clip of a cube's ray by all 24 tetrahedra at once (each distinct row of the
+  barycentric matrices evaluated once, constant indices), which finds the tetrahedra the isosurface program tests;
 * ``simplex/tet_steps.glsl`` -- de Casteljau steps of tetrahedral BB polynomials of degree 3 -> 2 -> 1 -> 0 with
   constant indices (no dynamic indexing of local arrays: that spills to memory on llvmpipe), and the
   restriction of a quadratic or cubic to a segment by blossoming ([Kalbe2008, sec. 5.3, Fig. 10]);
@@ -70,6 +72,42 @@ def type6() -> str:
             f"const vec4 SV_TET_BARY[96] = vec4[96]({rows});\n")
 
 
+def tet_clip() -> str:
+    """The candidates of a cube's ray: ``sv_tet_clip_all`` clips the ray by all 24 tetrahedra with every distinct
+    row of SV_TET_BARY evaluated once (30 of the 96), constant indices only."""
+    M = barycentric_matrices()
+    Q = rationals(M, max_den=2, what="barycentric matrix entry")
+    rows, index = [], {}
+    for t in range(24):
+        for i in range(4):
+            key = (tuple(Q[16 * t + 4 * i:16 * t + 4 * i + 4]), i == 0)
+            if key not in index:
+                index[key] = len(rows)
+                rows.append(key)
+    out = [HEAD, "// Clip of the cube-local ray P0 + t D, t >= tmin, by each of the 24 tetrahedra of partition.glsl, as the\n",
+           "// isosurface program's per-tetrahedron clip does it (lam_i >= -margin, the cube margin for lam_0, the inner\n",
+           "// margin for lam_1..3) with the same arithmetic, but each of the 30 distinct (row, margin) pairs of\n",
+           "// SV_TET_BARY evaluated once and no table read: bit cand[t] set when tetrahedron t is relevant (mask) and its\n",
+           "// segment [ta, tb] is not empty.\n",
+           "int sv_tet_clip_all(vec3 P0, vec3 D, float tmin, float cube_margin, float inner_margin, int mask) {\n"]
+    for r, (m, first) in enumerate(rows):
+        xyz, w = ", ".join(_f(q) for q in m[:3]), _f(m[3])
+        out.append(f"    float lo{r} = dot(vec3({xyz}), P0) + {w};\n")
+        out.append(f"    float ld{r} = dot(vec3({xyz}), D);\n")
+        out.append(f"    float lim{r} = -{'cube_margin' if first else 'inner_margin'} - lo{r};\n")
+        out.append(f"    float q{r} = lim{r} / (ld{r} != 0.0 ? ld{r} : 1.0);\n")
+    out.append("    int cand = 0;\n")
+    for t in range(24):
+        rs = [index[(tuple(Q[16 * t + 4 * i:16 * t + 4 * i + 4]), i == 0)] for i in range(4)]
+        out.append(f"    {{  // tetrahedron {t}\n        float a = tmin;\n        float b = 3.0e38;\n        bool empty = false;\n")
+        for r in rs:
+            out.append(f"        if (ld{r} > 0.0) a = max(a, q{r}); else if (ld{r} < 0.0) b = min(b, q{r}); "
+                       f"else if (lim{r} > 0.0) empty = true;\n")
+        out.append(f"        if (((mask >> {t}) & 1) != 0 && !empty && a <= b) cand |= {1 << t};\n    }}\n")
+    out.append("    return cand;\n}\n")
+    return "".join(out)
+
+
 def _index(m):
     return {tuple(int(v) for v in a): q for q, a in enumerate(multi_indices(m, 3))}
 
@@ -82,7 +120,7 @@ def _step(m):
         terms = " + ".join(f"l[{j}] * s[{src[e[j]]}]" for j in range(4))
         lines.append(f"    d[{q}] = {terms};")
     if m == 1:
-        return f"float sv_tet_step1(float s[4], vec4 l) {{\n" + lines[0].replace("    d[0] = ", "    return ") + "\n}\n"
+        return "float sv_tet_step1(float s[4], vec4 l) {\n" + lines[0].replace("    d[0] = ", "    return ") + "\n}\n"
     return f"void sv_tet_step{m}(float s[{len(src)}], vec4 l, out float d[{len(dst)}]) {{\n" + "\n".join(lines) + "\n}\n"
 
 
@@ -254,7 +292,7 @@ def stencil(scheme: str) -> str:
 
 
 def generate() -> dict:
-    files = {"type6/partition.glsl": type6(), "simplex/tet_steps.glsl": tet_steps()}
+    files = {"type6/partition.glsl": type6(), "type6/tet_clip.glsl": tet_clip(), "simplex/tet_steps.glsl": tet_steps()}
     for scheme in SCHEME_DEGREE:
         files[f"type6/stencil_{scheme}.glsl"] = stencil(scheme)
     files["type6/determining_cubic.glsl"] = determining("cubic")

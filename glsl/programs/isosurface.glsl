@@ -22,6 +22,7 @@
 #include "lib/core/table.glsl"
 #include "lib/core/roots.glsl"
 #include "lib/type6/partition.glsl"
+#include "lib/type6/tet_clip.glsl"
 #include "lib/simplex/tet_steps.glsl"
 #ifdef SV_VOLUME_CUBIC
 #include "lib/type6/stencil_cubic.glsl"
@@ -251,27 +252,7 @@ float sv_cube_first_hit_candidates(ivec3 c, int mask, int row, vec3 P0, vec3 D, 
     float t_best = SV_NO_HIT;
     tet_best = -1;
     rank_best = 0;
-    int cand = 0;
-    for (int t = 0; t < 24; ++t) {
-        if (((mask >> t) & 1) == 0) continue;
-        vec4 lo;
-        vec4 ld;
-        for (int i = 0; i < 4; ++i) {
-            vec4 m = SV_TET_BARY[4 * t + i];
-            lo[i] = dot(m.xyz, P0) + m.w;
-            ld[i] = dot(m.xyz, D);
-        }
-        float ta = tmin;
-        float tb = 3.0e38;
-        bool empty = false;
-        for (int i = 0; i < 4; ++i) {
-            float lim = -(i == 0 ? sv_cube_margin : sv_inner_margin) - lo[i];
-            if (ld[i] > 0.0) ta = max(ta, lim / ld[i]);
-            else if (ld[i] < 0.0) tb = min(tb, lim / ld[i]);
-            else if (lim > 0.0) empty = true;
-        }
-        if (!empty && ta <= tb) cand |= 1 << t;
-    }
+    int cand = sv_tet_clip_all(P0, D, tmin, sv_cube_margin, sv_inner_margin, mask);
     for (int k = 0; k < 24; ++k) {
         if (cand == 0) break;
         int low = cand & (-cand);
