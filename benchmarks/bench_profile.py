@@ -14,7 +14,9 @@ full-screen oblique view at 800x600, one light, here with the C1 scheme. Measure
   the same coefficient texture per step (``debug="raymarch"``), at 0 steps (ray set-up, box clip, rasterization
   and frame: the floor), at the full program's mean number of walk steps per fragment and at 64 steps;
 * ``full`` and ``raymarch`` again in new processes with ``LP_NUM_THREADS=1`` and ``2`` (llvmpipe reads it
-  once, at start-up), for the rate per rasterizer thread.
+  once, at start-up), for the rate per rasterizer thread;
+* today's build of the ray-cast families against the new one, in one process (``bench_speedup.py``: the
+  terrain of this scene and Marschner-Lobb isosurfaces), with the ratios today / new.
 
 Fragments are the pixels the proxy covers (every one runs the program, hit or miss), counted by the
 counters build (:func:`splinevis.analysis.profile.fragment_counters`), whose summary (walk steps, cells tested,
@@ -149,8 +151,11 @@ def bench_profile(repeats, quick):
     breakdown = [{"part": name, "ms": v, "share": v / ms["full"]} for name, v in parts]
     scene = (f"C1 fractal terrain {GRID}x{GRID} ({terrain.num_patches:,} patches), full-screen oblique view, "
              f"{WINDOW[0]}x{WINDOW[1]}, 1 light")
+    from bench_speedup import bench_speedup
+
     return {"scene": scene, "frames": rows, "breakdown": breakdown, "counters": summary,
-            "load_average": {"before": load_before, "after": os.getloadavg(), "cpus": len(os.sched_getaffinity(0))}}
+            "load_average": {"before": load_before, "after": os.getloadavg(), "cpus": len(os.sched_getaffinity(0))},
+            "speedup": bench_speedup(max(3, repeats // 2) if quick else repeats)}
 
 
 def _load(result, when):
@@ -159,7 +164,10 @@ def _load(result, when):
 
 def profile_markdown(result) -> str:
     """Markdown tables of :func:`bench_profile`'s result."""
-    lines = [f"\n## Where a terrain frame's time goes\n\n{result['scene']}; {result['frames'][0]['fragments']:,} "
+    from bench_speedup import speedup_markdown
+
+    lines = [speedup_markdown(result["speedup"]) if "speedup" in result else "",
+             f"\n## Where a terrain frame's time goes\n\n{result['scene']}; {result['frames'][0]['fragments']:,} "
              f"fragments (proxy pixels) per frame. Load average (1, 5, 15 min) before "
              f"{_load(result, 'before')}, after {_load(result, 'after')} on {result['load_average']['cpus']} cpus.\n",
              "| configuration | LP threads | min ms | median ms | min / full | M fragments/s | M fragments/s per thread "
@@ -206,5 +214,5 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    sys.path[:0] = [str(Path(__file__).resolve().parents[1]), str(Path(__file__).resolve().parent)]
     sys.exit(main())

@@ -17,7 +17,9 @@ Cases
   min/max hierarchy on and off (the hierarchical equivalent of the front-to-back occlusion sets of [Reis2008, sec. VII]).
 * ``profile``: where a full-screen C1 terrain frame's time goes (``bench_profile.py``): the full program, shading
   replaced by a constant, the hierarchy walk alone and a reference ray march, in fragments/s and per llvmpipe
-  thread (new processes at ``LP_NUM_THREADS=1`` and ``2``), with the per-fragment work counters of a debug build.
+  thread (new processes at ``LP_NUM_THREADS=1`` and ``2``), with the per-fragment work counters of a debug build;
+  and the terrain and isosurface programs' previous builds against the current ones, full-screen frames in one
+  process, with the ratios today / new (``bench_speedup.py``).
 * ``mesh_guided``: the mesh-guided terrain program (``proxy="mesh"``) against the box ray cast and a plain mesh of
   the same triangles, full-screen C1 terrain, one run (``bench_mesh_guided.py``).
 * ``outofcore``: terrain and volume splines built tile by tile on dask and written to zarr
