@@ -348,6 +348,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     ivec3 a = clamp(ivec3(floor(Pb + (t0 + 1e-4 * (t1 - t0)) * D)), ivec3(0), iext - ivec3(1));
     ivec3 stepdir = ivec3(D.x > 0.0 ? 1 : -1, D.y > 0.0 ? 1 : -1, D.z > 0.0 ? 1 : -1);
 #ifdef SV_VOLUME_LEGACY
+    // the walk before the rounds below (kept for the side-by-side timing of benchmarks/bench_speedup.py): the cube
+    // test inside the DDA's loop body; the same hits, bit for bit
     for (int s = 0; s < 3 * SV_MAX_BLOCK; ++s) {
         vec3 lo = vec3(a);
         vec3 texit;

@@ -198,8 +198,8 @@ bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     return true;
 }
 #elif defined(SV_TERRAIN_LEGACY)
-// Today's walk before the rounds below (kept for the benchmarks' side-by-side timing: benchmarks/bench_profile.py):
-// the cell test inside the walk's loop body. Same hits as the default walk, bit for bit.
+// The walk before the rounds below (SV_TERRAIN_LEGACY, kept for the side-by-side timing of
+// benchmarks/bench_speedup.py): the cell test inside the walk's loop body. Same hits as the default walk, bit for bit.
 bool sv_surface_hit(vec3 ro, vec3 rd, float tmin, out SvHit hit) {
     hit.curvature = vec2(0.0);
     hit.depth = 0.0;

@@ -3,6 +3,11 @@
 Declares :data:`PROGRAM` for the registry: the GPU spec (coefficient and hierarchy tables, uniforms), the
 float64 twin (:func:`splinevis.terrain.raycast.raycast_terrain`), the derived depth bound and the hard cases
 (:mod:`splinevis.terrain.hard_cases`).
+
+The walk runs in rounds (the hierarchy walk in its own loop, then one cell test for the whole SIMD group: llvmpipe
+runs a loop body's every instruction for all fragments of a group); the previous walk, with the cell test inside the
+walk's loop body and the same hits bit for bit, stays compiled under the flag ``SV_TERRAIN_LEGACY``
+(``actor.set_variant({"SV_TERRAIN_LEGACY": True})``) for the side-by-side timing of benchmarks/bench_speedup.py.
 """
 
 from __future__ import annotations

@@ -16,6 +16,11 @@ for measurement (tables in :mod:`splinevis.volume.tables`):
   glsl/lib/type6/determining_cubic.glsl).
 
 Bounding geometry: :mod:`splinevis.volume.proxies`; hard cases: :mod:`splinevis.volume.hard_cases`.
+
+The block's cubes are walked in rounds and a cube's tetrahedra tested once per candidate (the ray's clip by all 24
+at once finds them); the previous code, with the same hits bit for bit, stays compiled under the flag
+``SV_VOLUME_LEGACY`` (``actor.set_variant({"SV_VOLUME_LEGACY": True})``) for the side-by-side timing of
+benchmarks/bench_speedup.py.
 """
 
 from __future__ import annotations
