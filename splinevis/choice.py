@@ -158,7 +158,7 @@ def renderers_for(program) -> tuple:
     and what the choice says about that ("" when the program declares an exact renderer).
 
     >>> [(r.name, r.rank, r.exact) for r in renderers_for("terrain")[0]]
-    [('mesh', 0, False), ('mesh_guided', 5, True), ('raycast', 10, True)]
+    [('mesh', 0, False), ('raycast', 10, True), ('mesh_guided', 15, True)]
     >>> rows, note = renderers_for("analytic_patch")
     >>> [(r.name, r.exact) for r in rows], note
     ([('raycast', True)], "program 'analytic_patch' declares no renderers: drawn by its own (raycast), its error estimated")
@@ -194,7 +194,7 @@ def choose(model, view: View, max_error_px: float, style=None, *, program=None, 
     [('mesh', 1), ('mesh', 3), ('mesh', 12)]
     >>> c = choose(t, v, 0.02, triangle_cap=50_000)  # k = 12 has 73,728 triangles
     >>> c.renderer, c.meets, [str(o) for o in c.options[-3:]]  # the exact renderers: the cheaper one
-    ('mesh_guided', True, ['mesh k=12: over the cap of 50,000 triangles', 'mesh_guided 0.0177 px (estimate)', 'raycast 0.0177 px (estimate)'])
+    ('raycast', True, ['mesh k=12: over the cap of 50,000 triangles', 'raycast 0.0177 px (estimate)', 'mesh_guided 0.0177 px (estimate)'])
     """
     from .effects import Style
 

@@ -138,13 +138,13 @@ def _franke_like():
     return TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
 
 
-def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
+def test_choice_refines_the_mesh_then_switches_to_the_box_ray_cast():
     t = _franke_like()
     v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 5))
     cache = {}
     picks = [choose(t, v, e, triangle_cap=50_000, cache=cache) for e in (4.0, 1.0, 0.3, 0.1, 0.03, 0.02)]
     ks = [c.level for c in picks if c.renderer == "mesh"]
-    assert [c.renderer for c in picks] == ["mesh"] * 5 + ["mesh_guided"]
+    assert [c.renderer for c in picks] == ["mesh"] * 5 + ["raycast"]
     assert ks == sorted(ks) and ks[0] == 1 and ks[-1] > ks[0]
     for c in picks:
         assert c.meets and c.error_px <= c.max_error_px
@@ -158,7 +158,7 @@ def test_choice_refines_the_mesh_then_switches_to_the_mesh_guided_ray_cast():
     # nothing meets a request below the sub-pixel snapping: the cheapest exact ray cast is drawn and the choice
     # says so
     c = choose(t, v, 1e-4, triangle_cap=50_000, cache=cache)
-    assert not c.meets and c.renderer == "mesh_guided" and "nothing meets" in c.message
+    assert not c.meets and c.renderer == "raycast" and "nothing meets" in c.message
 
 
 @pytest.mark.parametrize("bad", [0, -1.0, math.nan, math.inf, "0.5", True])
@@ -176,7 +176,7 @@ def _foreground(image):
 
 
 @pytest.mark.parametrize("case, expected", [
-    ("terrain mesh", "mesh"), ("terrain colormap", "mesh_guided"), ("sphere mesh", "mesh"), ("sphere fine", "raycast")])
+    ("terrain mesh", "mesh"), ("terrain colormap", "raycast"), ("sphere mesh", "mesh"), ("sphere fine", "raycast")])
 def test_each_choice_renders(case, expected):
     pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
     if case.startswith("terrain"):

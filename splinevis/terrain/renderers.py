@@ -6,9 +6,10 @@
   the float32 rounding of the vertices (:func:`splinevis.gl.renderers.float32_margin`), turned into pixels
   over each cell's box (:meth:`splinevis.gl.screen_error.View.box_pixels`); rank 0.
 * ``mesh_guided``: the program with ``proxy="mesh"`` (:mod:`splinevis.terrain.mesh_proxy`), the same picture
-  as the box ray cast (the same hard cases agree with the float64 twin) at 2.5-4x less time per frame on this
-  machine (benchmarks/bench_mesh_guided.py): rank 5, between meshes and the box ray cast; the ray cast's
-  error.
+  as the box ray cast (the same hard cases agree with the float64 twin), the ray cast's error. It was 2.5-4x
+  cheaper than the box ray cast; since the box ray cast walks its cells in rounds (4x faster,
+  docs/results/profile/) it is the slower of the two (222 against 163 ms on the profile scene): rank 15, above
+  the box ray cast, so it is drawn only where the box ray cast is excluded.
 * ``raycast``: the program itself (box proxy), rank 10.
 
 Ranks are the measured costs of :mod:`splinevis.choice` (docs/results/terrain/pareto.md).
@@ -65,6 +66,6 @@ def _mesh_build(plotter, terrain, style, k, cache, spline_options, add_options):
 #: The terrain's renderers (module docstring), declared on :data:`splinevis.terrain.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, _mesh_triangles, mesh_refuses),
-    Renderer("mesh_guided", 5, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1}),
+    Renderer("mesh_guided", 15, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1}),
     Renderer("raycast", 10, exact=True),
 )
