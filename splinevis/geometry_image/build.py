@@ -301,8 +301,8 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         used instead of parametrizing again (its stage times are then not in the report).
     smoothing : float
         Width, in control cells, over which the samples are moved along the mesh before the fit so that the
-        parametrization the fit sees is smooth (:mod:`.regularize`: it removed 97 % of the folds of a real
-        scan); 0 samples the spherical map as it is.
+        parametrization the fit sees is smooth (:mod:`.regularize`: on the nefertiti scan 12,747 -> 1,062
+        folded limit triangles at level 3); 0 samples the spherical map as it is.
     orientation : "auto", None or (3, 3) array
         The rotation of the sphere under the octahedron: ``"auto"`` picks the one that samples the most compressed
         part of the mesh best (:func:`.orient.best_orientation`), None keeps the parametrization's own.

@@ -14,7 +14,7 @@ The smoothing moves every sample toward the mean of its four grid neighbours (th
 the way, only along the tangent plane of the mesh triangle it lies on, then back onto the mesh (its closest
 point, by libigl's AABB tree). Each step diffuses the grid by a variance of ``alpha / 2`` samples squared, so
 ``2 (sigma k)^2 / alpha`` steps smooth it over ``sigma`` control cells at ``k`` samples per cell;
-:data:`SIGMA_CELLS` is one cell, well inside the cubic B-spline's support of four. Three guards:
+:data:`SIGMA_CELLS` is one cell, well inside the cubic B-spline's support of four. Two guards:
 
 * a sample whose closest point lies on a triangle facing more than 60 degrees away stays: that is a jump (to a
   thin ear's far side), not a move. (A bound on each step's move on the sphere, one sample spacing, was tried:
