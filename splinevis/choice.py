@@ -58,7 +58,7 @@ from .gl.renderers import Choice, Option, Renderer
 from .gl.screen_error import SNAP_PX, View
 from .plotting_options import split_read_options
 
-__all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_for", "check_max_error",
+__all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_for", "check_max_error", "check_requests",
            "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px"]
 
 log = logging.getLogger("splinevis")
@@ -71,19 +71,46 @@ TRIANGLE_CAP = 2_097_152
 _SPLINE_KEYS = ("name", "newton_iterations", "program_options", "program")
 
 
-def check_max_error(max_error_px) -> float:
-    """``max_error_px`` as a float; ValueError unless it is a positive finite number.
+def check_max_error(max_error_px, what: str = "max_error_px", unit: str = "pixels (e.g. 0.5)") -> float:
+    """``max_error_px`` (or the request named ``what``) as a float; ValueError unless it is a positive finite
+    number.
 
     >>> check_max_error(0.5)
     0.5
     >>> check_max_error(0)
     Traceback (most recent call last):
     ValueError: max_error_px must be a positive finite number of pixels (e.g. 0.5), got 0.
+    >>> check_max_error(-1, "max_normal_error_deg", "degrees (e.g. 1)")
+    Traceback (most recent call last):
+    ValueError: max_normal_error_deg must be a positive finite number of degrees (e.g. 1), got -1.
     """
     ok = isinstance(max_error_px, (int, float, np.integer, np.floating)) and not isinstance(max_error_px, bool)
     if not ok or not math.isfinite(float(max_error_px)) or float(max_error_px) <= 0:
-        raise ValueError(f"max_error_px must be a positive finite number of pixels (e.g. 0.5), got {max_error_px!r}.")
+        raise ValueError(f"{what} must be a positive finite number of {unit}, got {max_error_px!r}.")
     return float(max_error_px)
+
+
+def check_requests(max_error_px, max_normal_error_deg) -> tuple:
+    """``(max_error_px, max_normal_error_deg)`` checked; a request not given bounds nothing (``max_error_px``
+    inf, the normal request None), but one of the two must be given.
+
+    >>> check_requests(None, 1), check_requests(0.5, None)
+    ((inf, 1.0), (0.5, None))
+    """
+    if max_error_px is None and max_normal_error_deg is None:
+        raise ValueError("give max_error_px (pixels) or max_normal_error_deg (degrees), or both.")
+    px = math.inf if max_error_px is None else check_max_error(max_error_px)
+    deg = None if max_normal_error_deg is None else check_max_error(max_normal_error_deg, "max_normal_error_deg",
+                                                                      "degrees (e.g. 1)")
+    return px, deg
+
+
+def _normal_error(renderer, model, view, level, cache):
+    """``(degrees, proven)`` of ``renderer`` (:attr:`Renderer.normal_error_deg`; exact renderers without one
+    shade with the spline's own normals: 0, meshes without one: unknown)."""
+    if renderer.normal_error_deg is not None:
+        return renderer.normal_error_deg(model, view, level, cache)
+    return (0.0, False) if renderer.exact else (math.inf, False)
 
 
 # ---------------------------------------------------------------------------------------------- ray cast
@@ -175,10 +202,12 @@ def renderers_for(program) -> tuple:
     return tuple(sorted(rows, key=lambda r: r.rank)), note
 
 
-def choose(model, view: View, max_error_px: float, style=None, *, program=None, triangle_cap: int = TRIANGLE_CAP,
-           cache: dict | None = None, exclude: dict | None = None) -> Choice:
+def choose(model, view: View, max_error_px: float | None, style=None, *, program=None, triangle_cap: int = TRIANGLE_CAP,
+           cache: dict | None = None, exclude: dict | None = None, max_normal_error_deg: float | None = None) -> Choice:
     """The cheapest renderer of ``model``'s program (``program``: a name or SplineProgram; default
-    ``program_for(model)``) meeting ``max_error_px`` for ``view`` (module docstring). Every renderer's error is
+    ``program_for(model)``) meeting ``max_error_px`` for ``view`` (module docstring), and
+    ``max_normal_error_deg`` when given (the normals it shades with within that many degrees of the spline's:
+    :attr:`Renderer.normal_error_deg`; either request may be None, not both). Every renderer's error is
     computed (meshes: up to the first ``k`` that meets the request or the cap) so that the choice can say what
     it passed over. ``exclude`` maps renderer names to the reason they may not be used; ``cache`` (a dict)
     keeps what the error functions computed for this model across calls.
@@ -198,7 +227,7 @@ def choose(model, view: View, max_error_px: float, style=None, *, program=None, 
     """
     from .effects import Style
 
-    max_error_px = check_max_error(max_error_px)
+    max_error_px, max_deg = check_requests(max_error_px, max_normal_error_deg)
     program = _program(model, program)
     rows, note = renderers_for(program)
     style = Style() if style is None else style
@@ -220,8 +249,11 @@ def choose(model, view: View, max_error_px: float, style=None, *, program=None, 
                 options.append(Option(r.name, level, math.inf, False, tri, reason=f"over the cap of {triangle_cap:,} triangles"))
                 break
             px, proven = (r.error_px or _own_error(program))(model, view, level, cache)
-            options.append(Option(r.name, level, float(px), proven, tri, meets=px <= max_error_px))
-            if px <= max_error_px:
+            deg, deg_proven = _normal_error(r, model, view, level, cache) if max_deg is not None else (None, False)
+            meets = px <= max_error_px and (deg is None or deg <= max_deg)
+            options.append(Option(r.name, level, float(px), proven, tri, meets=meets,
+                                  normal_deg=None if deg is None else float(deg), normal_proven=bool(deg_proven)))
+            if meets:
                 break
         if chosen is None:
             chosen = next((o for o in options if o.meets), None)
@@ -231,8 +263,9 @@ def choose(model, view: View, max_error_px: float, style=None, *, program=None, 
         if not pool:
             raise ValueError(f"no renderer of program {program.name!r} may draw this: "
                              + "; ".join(str(o) for o in options) + ".")
-        chosen = min([o for o in pool if o.name in exact] or pool, key=lambda o: o.error_px)
-    return Choice(program.name, max_error_px, chosen, tuple(options), view, note)
+        chosen = min([o for o in pool if o.name in exact] or pool,
+                     key=lambda o: (o.error_px if max_error_px < math.inf else 0.0, o.normal_deg or 0.0))
+    return Choice(program.name, max_error_px, chosen, tuple(options), view, note, max_deg)
 
 
 def _model_bounds(model, program, style):
@@ -250,7 +283,7 @@ def _model_bounds(model, program, style):
 
 
 def add_by_accuracy(plotter, program: str, args, read_options, style, options, max_error_px, *, style_from,
-                    add_options=None):
+                    add_options=None, max_normal_error_deg=None):
     """Build the model of ``program`` from ``args``, choose its renderer for ``max_error_px`` and add it
     (what ``Plotter.add_terrain/add_isosurface(..., max_error_px=...)`` do; :func:`add_model_by_accuracy`).
     The reader's keywords (``order``, ``spacing``, ``origin``) may be in ``options`` as in ``read_options``
@@ -269,15 +302,17 @@ def add_by_accuracy(plotter, program: str, args, read_options, style, options, m
     """
     from .programs import get
 
-    max_error_px = check_max_error(max_error_px)
+    check_requests(max_error_px, max_normal_error_deg)
     read_options, options = split_read_options(program, read_options, options)
     spline_options = {k: options.pop(k) for k in _SPLINE_KEYS if k in options}
     st = style_from(style, options)
     model = get(program).model_from(*args, **read_options)
-    return add_model_by_accuracy(plotter, model, st, max_error_px, add_options=add_options, **spline_options)
+    return add_model_by_accuracy(plotter, model, st, max_error_px, add_options=add_options,
+                                 max_normal_error_deg=max_normal_error_deg, **spline_options)
 
 
-def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=None, program=None, **spline_options):
+def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=None, program=None,
+                          max_normal_error_deg=None, **spline_options):
     """Choose the renderer of ``model`` (its program's, or the one named ``program``) for ``max_error_px`` and
     add it (what ``Plotter.add_spline(model, max_error_px=...)`` does); ``style`` is a Style,
     ``spline_options`` are ``add_spline``'s ``name``, ``newton_iterations``, ``program_options`` (None: not
@@ -305,7 +340,7 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
 
     from vtkmodules.vtkRenderingCore import vtkCamera
 
-    max_error_px = check_max_error(max_error_px)
+    check_requests(max_error_px, max_normal_error_deg)
     spline_options = {k: v for k, v in spline_options.items() if v is not None}
     unknown = sorted(set(spline_options) - set(_SPLINE_KEYS))
     if unknown:
@@ -336,7 +371,7 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     plain = {r.name for r in rows if r.build is None and not r.program_options}
     exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in rows if given and r.name not in plain}
     choice = choose(model, View.from_renderer(ren, plotter.window_size), max_error_px, style, program=prog,
-                    cache=(cache := {}), exclude=exclude)
+                    cache=(cache := {}), exclude=exclude, max_normal_error_deg=max_normal_error_deg)
     entry = next(r for r in rows if r.name == choice.renderer)
     build = entry.build or partial(_add_own, renderer=entry)
     actor = build(plotter, model, style, choice.level, cache, spline_options, add_options)

@@ -163,7 +163,8 @@ class Plotter(pv.Plotter):
 
     def add_spline(self, model, style: Style | None = None, *, name: str | None = None,
                    newton_iterations: int | None = None, program_options: dict | None = None,
-                   program: str | None = None, max_error_px: float | None = None, **style_options) -> SplineActor:
+                   program: str | None = None, max_error_px: float | None = None,
+                   max_normal_error_deg: float | None = None, **style_options) -> SplineActor:
         """Add a spline model, drawn exactly per pixel by its program, beside any ordinary meshes.
 
         The model's program is found in the registry (:func:`splinevis.programs.program_for`).
@@ -187,7 +188,12 @@ class Plotter(pv.Plotter):
             detail as one mesh, instead of the per-fragment ``"nurbs"``); default: the model's program.
         max_error_px : float, optional
             Draw it the cheapest way its program declares whose screen-space error stays below that many
-            pixels for the current camera (:mod:`splinevis.choice`); the actor's ``renderer_choice`` says which.
+            pixels for the current camera (:mod:`splinevis.choice`); the actor's ``choice`` says which. The
+            choice is made again when the camera moves (:func:`splinevis.choice.add_model_by_accuracy`).
+        max_normal_error_deg : float, optional
+            With or without ``max_error_px``: the normals it is shaded with (reflection lines, isophotes) stay
+            within that many degrees of the spline's exact normals (a mesh whose normal error is proven that
+            small, or an exact renderer).
 
         Returns
         -------
@@ -211,11 +217,12 @@ class Plotter(pv.Plotter):
         from .programs import get, program_for
 
         st = _style_from(style, style_options)
-        if max_error_px is not None:
+        if max_error_px is not None or max_normal_error_deg is not None:
             from .choice import add_model_by_accuracy
 
             return add_model_by_accuracy(self, model, st, max_error_px, name=name, newton_iterations=newton_iterations,
-                                         program_options=program_options, program=program)
+                                         program_options=program_options, program=program,
+                                         max_normal_error_deg=max_normal_error_deg)
         program = program_for(model) if program is None else get(program)
         if not isinstance(model, (program.model_type, str, os.PathLike) + tuple(program.converts)):
             raise TypeError(f"program {program.name!r} draws {program.model_type.__name__}, not {type(model).__name__}.")
@@ -253,7 +260,8 @@ class Plotter(pv.Plotter):
         return actors
 
     def add_terrain(self, heights, scheme: str = "C1", style: Style | None = None, *, read_options: dict | None = None,
-                    presmooth: int = 0, max_error_px: float | None = None, **options):
+                    presmooth: int = 0, max_error_px: float | None = None, max_normal_error_deg: float | None = None,
+                    **options):
         """Build a terrain spline from height data and add it (see :meth:`add_spline` for ``options``).
 
         ``max_error_px``: draw it the cheapest way whose screen-space error stays below that many pixels for
@@ -283,11 +291,11 @@ class Plotter(pv.Plotter):
         2048
         """
         read_options, options = split_read_options("terrain", read_options, options)
-        if max_error_px is not None:
+        if max_error_px is not None or max_normal_error_deg is not None:
             from .choice import add_by_accuracy
 
             return add_by_accuracy(self, "terrain", (heights, scheme, presmooth), read_options, style, options,
-                                   max_error_px, style_from=_style_from)
+                                   max_error_px, style_from=_style_from, max_normal_error_deg=max_normal_error_deg)
         return self._add_from("terrain", (heights, scheme, presmooth), read_options, style, options)
 
     def add_terrain_store(self, store, box=None, **options):
@@ -334,7 +342,8 @@ class Plotter(pv.Plotter):
 
     def add_isosurface(self, volume, isovalue: float, scheme: str = "quadratic", style: Style | None = None, *,
                        read_options: dict | None = None, newton_iterations: int = 6, culling: bool = True,
-                       max_error_px: float | None = None, prefilter: str = "none", padding: str = "linear",
+                       max_error_px: float | None = None, max_normal_error_deg: float | None = None,
+                       prefilter: str = "none", padding: str = "linear",
                        **options):
         """Ray-cast the isosurface ``s = isovalue`` of a trivariate spline of volume data [Kalbe2008].
 
@@ -370,12 +379,13 @@ class Plotter(pv.Plotter):
         True
         """
         read_options, options = split_read_options("isosurface", read_options, options)
-        if max_error_px is not None:
+        if max_error_px is not None or max_normal_error_deg is not None:
             from .choice import add_by_accuracy
 
             return add_by_accuracy(self, "isosurface", (volume, isovalue, scheme, prefilter, padding), read_options, style,
                                    dict(options, newton_iterations=newton_iterations), max_error_px,
-                                   style_from=_style_from, add_options={"culling": culling})
+                                   style_from=_style_from, add_options={"culling": culling},
+                                   max_normal_error_deg=max_normal_error_deg)
         return self._add_from("isosurface", (volume, isovalue, scheme, prefilter, padding), read_options, style,
                               dict(options, newton_iterations=newton_iterations), {"culling": culling})
 

@@ -58,6 +58,12 @@ class Renderer:
         Draws the spline itself: among these the choice falls back on when nothing meets the request.
     program_options : tuple of (name, value) pairs
         Program options the program is built with when ``build`` is None (a dict is accepted).
+    normal_error_deg : callable, optional
+        ``normal_error_deg(model, view, level, cache) -> (degrees, proven)``: the largest angle between the
+        normal the renderer shades with and the spline's exact normal at the point it stands for. None: an
+        exact renderer evaluates the spline's own normal per pixel (``exact normals``: float32 rounding only,
+        which the program's hard cases compare with its float64 twin); a mesh's is unknown and never meets a
+        ``max_normal_error_deg`` request.
 
     Examples
     --------
@@ -76,6 +82,7 @@ class Renderer:
     refuses: Callable | None = None
     exact: bool = False
     program_options: tuple = ()
+    normal_error_deg: Callable | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -91,12 +98,18 @@ class Renderer:
 @dataclass(frozen=True)
 class Option:
     """A renderer considered: its name, level (``k``; None for ray casts), screen-space error (pixels; inf
-    when unknown), whether that error is proven, triangles (meshes), whether it meets the request and why not.
+    when unknown), whether that error is proven, triangles (meshes), whether it meets the request and why not;
+    when the request bounds the normals too, the normal error (degrees; 0 for exact normals, inf unknown) and
+    whether it is proven (``normal_deg`` None: not asked).
 
     >>> str(Option("mesh", 2, 0.8, True, 1024, True))
     'mesh k=2 0.8 px (proven, 1,024 triangles)'
     >>> str(Option("surface", None, float("inf"), False))
     'surface (error unknown)'
+    >>> str(Option("mesh", 4, 0.2, True, 4096, True, normal_deg=0.61, normal_proven=True))
+    'mesh k=4 0.2 px (proven, 4,096 triangles), normals 0.61 deg (proven)'
+    >>> str(Option("raycast", None, 0.01, False, normal_deg=0.0))
+    'raycast 0.01 px (estimate), exact normals'
     """
 
     name: str
@@ -106,6 +119,8 @@ class Option:
     triangles: int | None = None
     meets: bool = False
     reason: str = ""
+    normal_deg: float | None = None
+    normal_proven: bool = False
 
     def __str__(self):
         label = self.name + ("" if self.level is None else f" k={self.level}")
@@ -116,7 +131,14 @@ class Option:
         extra = "proven" if self.proven else "estimate"
         if self.triangles is not None:
             extra += f", {self.triangles:,} triangles"
-        return f"{label} {self.error_px:.3g} px ({extra})"
+        text = f"{label} {self.error_px:.3g} px ({extra})"
+        if self.normal_deg is None:
+            return text
+        if self.normal_deg == 0.0:
+            return text + ", exact normals"
+        if self.normal_deg == float("inf"):
+            return text + ", normal error unknown"
+        return text + f", normals {self.normal_deg:.3g} deg ({'proven' if self.normal_proven else 'estimate'})"
 
 
 @dataclass(frozen=True)
@@ -139,6 +161,7 @@ class Choice:
     options: tuple
     view: View | None = field(default=None, repr=False)
     note: str = ""
+    max_normal_error_deg: float | None = None
 
     @property
     def renderer(self) -> str:
@@ -186,8 +209,10 @@ class Choice:
         'splinevis: dots drawn as mesh (error unknown); nothing meets max_error_px=0.5, drawing the exact renderer; it declares no renderers'
         """
         head = f"splinevis: {self.program} drawn as {self.chosen}"
-        head += (f" <= max_error_px={self.max_error_px:g}" if self.meets
-                 else f"; nothing meets max_error_px={self.max_error_px:g}, drawing the exact renderer")
+        request = f"max_error_px={self.max_error_px:g}"
+        if self.max_normal_error_deg is not None:
+            request += f", max_normal_error_deg={self.max_normal_error_deg:g}"
+        head += (f" <= {request}" if self.meets else f"; nothing meets {request}, drawing the exact renderer")
         others = [str(o) for o in self.options if o is not self.chosen]
         return head + ("; considered: " + ", ".join(others) if others else "") + (f"; {self.note}" if self.note else "")
 

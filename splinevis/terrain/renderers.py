@@ -4,7 +4,9 @@
 * ``mesh``: the spline sampled ``k x k`` per cell (:mod:`splinevis.terrain.sampled_mesh`), **proven**:
   vertical chord <= M h^2 / 4 per cell (h = 1/k, M the Hessian bound from the BB second differences), plus
   the float32 rounding of the vertices (:func:`splinevis.gl.renderers.float32_margin`), turned into pixels
-  over each cell's box (:meth:`splinevis.gl.screen_error.View.box_pixels`); rank 0.
+  over each cell's box (:meth:`splinevis.gl.screen_error.View.box_pixels`); rank 0. Its normals are the
+  spline's at the vertices, interpolated: **proven** within ``||H|| l`` radians of the spline's normal at
+  the same ``(x, y)`` (:func:`mesh_normal_error_deg`).
 * ``mesh_guided``: the program with ``proxy="mesh"`` (:mod:`splinevis.terrain.mesh_proxy`), the same picture
   as the box ray cast (the same hard cases agree with the float64 twin), the ray cast's error. It was 2.5-4x
   cheaper than the box ray cast; since the box ray cast walks its cells in rounds (4x faster,
@@ -17,10 +19,12 @@ Ranks are the measured costs of :mod:`splinevis.choice` (docs/results/terrain/pa
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "RENDERERS"]
+__all__ = ["mesh_error_px", "mesh_normal_error_deg", "RENDERERS"]
 
 
 def _boxes_and_hessian(terrain, cache):
@@ -51,6 +55,34 @@ def mesh_error_px(terrain, view, k, cache):
     return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, True
 
 
+def mesh_normal_error_deg(terrain, view, k, cache):
+    """(degrees, True): the largest angle between the normal the ``k x k`` sampled mesh shades with and the
+    spline's normal at the same ``(x, y)``, over all cells.
+
+    Derivation. The normal of the graph ``z = f(x, y)`` is ``n = g / |g|``, ``g = (-f_x, -f_y, 1)``, so
+    ``dn = (I - n n^T) dg / |g|`` and ``|dn| <= |dg| <= ||H|| |dp|`` (``|g| >= 1``; ``H`` the world Hessian,
+    ``||H|| <= M / min(s_x, s_y)^2`` with ``M`` the index-unit bound of :mod:`.sampled_mesh` and ``s`` the cell
+    spacing). The angle between ``n(p)`` and a vertex normal ``n_i`` is at most the length of the path of ``n``
+    along the segment, ``||H|| |p - p_i| <= ||H|| l`` with ``l = sqrt(s_x^2 + s_y^2) / k`` the sub-triangles'
+    longest side. The rasterizer shades with a normalized convex combination of the ``n_i``; all lie in the
+    spherical cap of that radius around ``n(p)``, which is convex while the radius is below 90 degrees, so the
+    shading normal is in it too. Float32 rounding of the unit normals adds ``8 u`` radians.
+
+    >>> import numpy as np
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:17, 0:17] / 16.0
+    >>> t = TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
+    >>> [round(mesh_normal_error_deg(t, None, k, {})[0], 2) for k in (1, 4, 16)]  # falls as 1 / k
+    [28.5, 7.13, 1.78]
+    """
+    from ..gl.error_bounds import U32
+
+    _, M = _boxes_and_hessian(terrain, cache)
+    sx, sy = (float(v) for v in terrain.cell_spacing)
+    radians = float(M.max()) / min(sx, sy) ** 2 * np.hypot(sx, sy) / k + 8.0 * U32
+    return float(np.degrees(min(radians, np.pi))), True
+
+
 def _mesh_triangles(terrain, k, cache):
     from .sampled_mesh import mesh_triangles
 
@@ -65,7 +97,8 @@ def _mesh_build(plotter, terrain, style, k, cache, spline_options, add_options):
 
 #: The terrain's renderers (module docstring), declared on :data:`splinevis.terrain.program.PROGRAM`.
 RENDERERS = (
-    Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, _mesh_triangles, mesh_refuses),
+    Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, _mesh_triangles, mesh_refuses,
+             normal_error_deg=mesh_normal_error_deg),
     Renderer("mesh_guided", 15, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1}),
     Renderer("raycast", 10, exact=True),
 )

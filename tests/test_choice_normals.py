@@ -1,0 +1,108 @@
+"""Normal error in the choice by accuracy (``max_normal_error_deg``): the terrain mesh's proven bound on the
+angle between the normal it shades with and the spline's (splinevis.terrain.renderers.mesh_normal_error_deg)
+holds against the float64 spline on hard terrains; the choice takes the coarsest mesh meeting both requests,
+an exact renderer when no mesh can, and says what it did."""
+
+import numpy as np
+import pytest
+
+import splinevis
+from datasets_synthetic.dem_files import fractal_terrain
+from splinevis.choice import choose
+from splinevis.gl.screen_error import View
+from splinevis.terrain.model import TerrainSpline
+from splinevis.terrain.renderers import mesh_normal_error_deg
+from splinevis.terrain.sampled_mesh import sampled_mesh
+
+N = 17
+
+
+def _bump():
+    y, x = np.mgrid[-1:1:N * 1j, -1:1:N * 1j]
+    return np.exp(-4 * (x * x + y * y))
+
+
+def _ridge():
+    y, x = np.mgrid[0:N, 0:N].astype(float)
+    return np.tanh(2.0 * (x - 0.4 * y - 5.0))
+
+
+TERRAINS = {"bump": _bump, "ridge": _ridge, "fractal": lambda: fractal_terrain(N, seed=5)}
+
+
+def _shading_normals(t, k, x, y):
+    """The mesh's vertex normals interpolated linearly on each sub-triangle (split along u = v) and normalized:
+    what the rasterizer shades with at (x, y)."""
+    mesh = sampled_mesh(t, k)
+    ncy, ncx = t.shape
+    n = mesh.point_data["Normals"].reshape(k * ncy + 1, k * ncx + 1, 3)
+    u, v = t.to_index(x, y)
+    a = np.minimum(np.floor(u * k).astype(int), k * ncx - 1)
+    b = np.minimum(np.floor(v * k).astype(int), k * ncy - 1)
+    lu, lv = (u * k - a)[:, None], (v * k - b)[:, None]
+    n00, n10, n11, n01 = n[b, a], n[b, a + 1], n[b + 1, a + 1], n[b + 1, a]
+    lower = n00 + lu * (n10 - n00) + lv * (n11 - n10)
+    upper = n00 + lv * (n01 - n00) + lu * (n11 - n01)
+    s = np.where(lv > lu, upper, lower)
+    return s / np.linalg.norm(s, axis=1, keepdims=True)
+
+
+def _spline_normals(t, x, y):
+    g = t.gradient(x, y)
+    n = np.column_stack([-g[:, 0], -g[:, 1], np.ones(len(x))])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize("name", sorted(TERRAINS))
+@pytest.mark.parametrize("scheme", ["C1", "C2"])
+@pytest.mark.parametrize("k", [1, 3, 8])
+def test_terrain_mesh_normal_bound_holds(name, scheme, k):
+    t = TerrainSpline.from_heights(TERRAINS[name](), scheme, spacing=(0.1, 0.15))
+    rng = np.random.default_rng(11)
+    x0, x1, y0, y1 = t.extent
+    x, y = rng.uniform(x0, x1, 20_000), rng.uniform(y0, y1, 20_000)
+    cos = np.clip(np.einsum("ij,ij->i", _shading_normals(t, k, x, y), _spline_normals(t, x, y)), -1.0, 1.0)
+    measured = float(np.degrees(np.arccos(cos)).max())
+    bound, proven = mesh_normal_error_deg(t, None, k, {})
+    assert proven
+    assert measured <= bound
+    assert measured > 0.0  # the sampling reaches inside triangles: the comparison is not vacuous
+
+
+def _view():
+    return View((0.8, -1.6, 1.4), (0.8, 0.8, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.3, 6))
+
+
+def test_choice_meets_the_normal_request_with_the_coarsest_mesh():
+    t = TerrainSpline.from_heights(_bump(), "C1", spacing=(0.1, 0.1))
+    loose = choose(t, _view(), 2.0)
+    both = choose(t, _view(), 2.0, max_normal_error_deg=10.0)  # a first-order bound: ~150 deg / k here
+    assert (loose.renderer, both.renderer) == ("mesh", "mesh")
+    assert both.level > loose.level  # the normals ask for more samples than the positions
+    assert both.chosen.normal_deg <= 10.0 and both.chosen.normal_proven
+    earlier = [o for o in both.options if o.name == "mesh" and o.level < both.level]
+    assert earlier and all(o.normal_deg > 10.0 or o.error_px > 2.0 for o in earlier)
+    assert "max_normal_error_deg=10" in both.message and "deg (proven)" in both.message
+
+
+def test_normal_request_alone_and_exact_renderers():
+    t = TerrainSpline.from_heights(_bump(), "C1", spacing=(0.1, 0.1))
+    only = choose(t, _view(), None, max_normal_error_deg=20.0)
+    assert only.renderer == "mesh" and only.max_error_px == float("inf") and only.chosen.normal_deg <= 20.0
+    capped = choose(t, _view(), None, max_normal_error_deg=1.0, triangle_cap=20_000)
+    assert capped.renderer == "raycast" and capped.chosen.normal_deg == 0.0  # exact normals, per pixel
+    assert "exact normals" in capped.message
+    with pytest.raises(ValueError, match="give max_error_px"):
+        choose(t, _view(), None)
+    with pytest.raises(ValueError, match="max_normal_error_deg must be a positive finite number of degrees"):
+        choose(t, _view(), 1.0, max_normal_error_deg=float("nan"))
+
+
+def test_plotter_takes_the_normal_request():
+    pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
+    actor = pl.add_terrain(_bump(), "C1", read_options={"spacing": (0.1, 0.1)}, max_normal_error_deg=15.0,
+                           reflection_lines=8)
+    assert actor.choice.renderer == "mesh" and actor.choice.chosen.normal_deg <= 15.0
+    img = pl.screenshot()
+    assert img.std() > 10
+    pl.close()
