@@ -319,8 +319,10 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     given), ``add_options`` go to the program's ``on_add``.
 
     The view is the plotter's camera if it was set, else pyvista's default view fitted to the model's bounds
-    (what the first render would show); the camera is then set to that view (moving it closer afterwards
-    can break the request: call again or choose for the final camera). Ray-cast options (``program_options``,
+    (what the first render would show); the camera is then set to that view. Before every render whose
+    camera or window changed, the choice is made again for the new view and the renderer it picks is drawn
+    instead (built once per renderer and level, kept hidden while not chosen: :func:`_follow_camera`), so
+    the request holds as the camera moves in. Ray-cast options (``program_options``,
     ``program``) exclude every renderer but the program's own plain one. The actor gets ``choice`` (a
     :class:`Choice`; also as ``renderer_choice``) and ``model``; the one-line ``Choice.message`` goes to the ``"splinevis"`` logger at INFO.
 
@@ -372,17 +374,79 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in rows if given and r.name not in plain}
     choice = choose(model, View.from_renderer(ren, plotter.window_size), max_error_px, style, program=prog,
                     cache=(cache := {}), exclude=exclude, max_normal_error_deg=max_normal_error_deg)
-    entry = next(r for r in rows if r.name == choice.renderer)
-    build = entry.build or partial(_add_own, renderer=entry)
-    actor = build(plotter, model, style, choice.level, cache, spline_options, add_options)
+    def build(c, options):
+        entry = next(r for r in rows if r.name == c.renderer)
+        return (entry.build or partial(_add_own, renderer=entry))(plotter, model, style, c.level, cache, options,
+                                                                  add_options)
+
+    actor = build(choice, spline_options)
     cam.DeepCopy(saved)
     ren.ResetCameraClippingRange()
-    for key, value in (("renderer_choice", choice), ("choice", choice), ("model", model)):
-        try:
-            setattr(actor, key, value)
-        except AttributeError:  # a pyvista Actor takes new attributes only this way
-            import pyvista as pv
-
-            pv.set_new_attribute(actor, key, value)
+    for key, value in (("renderer_choice", choice), ("choice", choice), ("model", model), ("drawn", actor)):
+        _set_attribute(actor, key, value)
     log.info(choice.message)
+    _follow_camera(plotter, actor, choice, build, spline_options,
+                   lambda view: choose(model, view, max_error_px, style, program=prog, cache=cache, exclude=exclude,
+                                       max_normal_error_deg=max_normal_error_deg))
     return actor
+
+
+def _set_attribute(actor, key, value):
+    try:
+        setattr(actor, key, value)
+    except AttributeError:  # a pyvista Actor takes new attributes only this way
+        import pyvista as pv
+
+        pv.set_new_attribute(actor, key, value)
+
+
+def _view_key(view: View) -> tuple:
+    """What decides a choice in a view: the camera and the window (not the clipping range, which VTK resets
+    at every render)."""
+    return (view.position, view.focal_point, view.view_up, view.view_angle, view.parallel, view.parallel_scale,
+            view.width, view.height)
+
+
+def _follow_camera(plotter, actor, choice, build, spline_options, rechoose):
+    """Make the choice again before each render whose camera or window differs from the last one chosen for,
+    and draw the renderer it picks: each (renderer, level) is built once and kept (hidden while another is
+    drawn), so moving back and forth costs no rebuild. ``actor`` (what the user holds) keeps the current
+    ``choice`` and the actor ``drawn``; ``actor.choices`` counts how often each (renderer, level) was chosen."""
+    ren = plotter.renderer
+    built = {(choice.renderer, choice.level): actor}
+    state = {"key": (choice.renderer, choice.level), "view": _view_key(View.from_renderer(ren, plotter.window_size)),
+             "busy": False}
+    _set_attribute(actor, "choices", {state["key"]: 1})
+
+    def before_render(caller, event):
+        if state["busy"]:
+            return
+        view = View.from_renderer(ren, plotter.window_size)
+        if _view_key(view) == state["view"]:
+            return
+        state["busy"] = True
+        try:
+            state["view"] = _view_key(view)
+            new = rechoose(view)
+            key = (new.renderer, new.level)
+            if key not in built:
+                from vtkmodules.vtkRenderingCore import vtkCamera
+
+                saved = vtkCamera()
+                saved.DeepCopy(ren.GetActiveCamera())
+                name = spline_options.get("name")
+                options = dict(spline_options, **({"name": f"{name} ({key[0]} {key[1]})"} if name else {}))
+                built[key] = build(new, options)
+                ren.GetActiveCamera().DeepCopy(saved)
+            if key != state["key"]:
+                built[state["key"]].SetVisibility(False)
+                built[key].SetVisibility(True)
+                log.info(new.message)
+            state["key"] = key
+            actor.choices[key] = actor.choices.get(key, 0) + 1
+            for k, v in (("choice", new), ("renderer_choice", new), ("drawn", built[key])):
+                _set_attribute(actor, k, v)
+        finally:
+            state["busy"] = False
+
+    ren.AddObserver("StartEvent", before_render)
