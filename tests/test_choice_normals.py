@@ -1,6 +1,7 @@
 """Normal error in the choice by accuracy (``max_normal_error_deg``): the terrain mesh's proven bound on the
 angle between the normal it shades with and the spline's (splinevis.terrain.renderers.mesh_normal_error_deg)
-holds against the float64 spline on hard terrains; the choice takes the coarsest mesh meeting both requests,
+holds against the float64 spline on hard terrains, and the isosurface mesh's estimate against the normal
+at the surface point a mesh point stands for; the choice takes the coarsest mesh meeting both requests,
 an exact renderer when no mesh can, and says what it did."""
 
 import numpy as np
@@ -106,3 +107,42 @@ def test_plotter_takes_the_normal_request():
     img = pl.screenshot()
     assert img.std() > 10
     pl.close()
+
+
+def _blobs():
+    z, y, x = np.mgrid[-1:1:18j, -1:1:18j, -1:1:18j]
+    return np.exp(-6 * ((x - 0.35) ** 2 + y * y + z * z)) + np.exp(-6 * ((x + 0.35) ** 2 + y * y + z * z))
+
+
+def _ball():
+    z, y, x = np.mgrid[-1:1:18j, -1:1:18j, -1:1:18j]
+    return np.sqrt(x * x + y * y + z * z)
+
+
+@pytest.mark.parametrize("field,iso", [(_ball, 0.6), (_blobs, 0.6)])
+@pytest.mark.parametrize("k", [1, 2, 4])
+def test_isosurface_mesh_normal_estimate_holds(field, iso, k):
+    from splinevis.volume.isosurface import Isosurface
+    from splinevis.volume.model import VolumeSpline
+    from splinevis.volume.renderers import mesh_normal_error_deg
+    from splinevis.volume.sampled_mesh import sampled_mesh
+
+    s = VolumeSpline(field(), order="zyx", spacing=(2 / 17,) * 3, origin=(-1, -1, -1))
+    surface = Isosurface(s, iso)
+    mesh = sampled_mesh(s, iso, k, surface.relevant)
+    tri = mesh.faces.reshape(-1, 4)[:, 1:]
+    rng = np.random.default_rng(3)
+    w = rng.dirichlet([1.0, 1.0, 1.0], len(tri))
+    p = np.einsum("tk,tkc->tc", w, mesh.points[tri])
+    shading = np.einsum("tk,tkc->tc", w, mesh.point_data["Normals"][tri])
+    shading /= np.linalg.norm(shading, axis=1, keepdims=True)
+    q = p.copy()
+    for _ in range(6):  # Newton along the gradient onto the surface: the point p stands for
+        v, g = s.evaluate(q, gradient=True)
+        q -= ((v - iso) / np.einsum("ij,ij->i", g, g))[:, None] * g
+    v, g = s.evaluate(q, gradient=True)
+    assert np.abs(v - iso).max() < 1e-9  # converged: q is on the surface
+    exact = g / np.linalg.norm(g, axis=1, keepdims=True)
+    measured = float(np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", shading, exact), -1, 1))).max())
+    bound, proven = mesh_normal_error_deg(surface, None, k, {})
+    assert not proven and 0.0 < measured <= bound

@@ -7,7 +7,9 @@
   the fine cell's diagonal, M the Hessian bound per relevant cube); it is turned into a distance with an
   **estimated** lower bound of |grad s| (the smallest at the ``k = 1`` mesh's vertices), plus the float32
   rounding of the vertices, and into pixels over each relevant cube's box. Rank 0; rotated lattices are
-  refused (the mesh is built in the lattice frame).
+  refused (the mesh is built in the lattice frame). Its normals are the spline's gradient directions at
+  the vertices, interpolated: within ``(M / g)(D + delta)`` radians of the exact normal at the surface point a
+  mesh point stands for (:func:`mesh_normal_error_deg`), an **estimate** since ``g`` is.
 * ``raycast``: the program itself, rank 10.
 
 Ranks are the measured costs of :mod:`splinevis.choice` (docs/results/volume/volume.md).
@@ -20,7 +22,7 @@ import numpy as np
 from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "RENDERERS"]
+__all__ = ["mesh_error_px", "mesh_normal_error_deg", "RENDERERS"]
 
 
 def _mesh1(surface, cache):
@@ -72,6 +74,40 @@ def mesh_error_px(surface, view, k, cache):
     return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, False
 
 
+def mesh_normal_error_deg(surface, view, k, cache):
+    """(degrees, False): the largest angle between the normal the mesh at ``k`` samples per cube shades with
+    and the spline's normal ``n = grad s / |grad s|`` at the surface point a mesh point stands for.
+
+    Derivation. ``dn = (I - n n^T) H dp / |grad s|``, so ``|dn| <= (M / g) |dp|`` on a cube (``M`` its Hessian
+    bound, ``g`` a lower bound of ``|grad s|``). A mesh point ``p`` of a fine cell stands for a surface point
+    ``q`` within ``delta`` (the distance bound of :func:`mesh_error_px`), and the triangle's vertices ``v_i``
+    are in the same fine cell, so ``|q - v_i| <= D + delta`` (``D`` the fine cell's diagonal): every vertex
+    normal is within ``(M / g)(D + delta)`` of ``n(q)`` (vertices on the mesh are within ``delta`` of the
+    surface; the gradient direction there is what they carry), and so is their normalized convex combination,
+    the shading normal (a spherical cap of radius below 90 degrees is convex). ``g`` is the smallest
+    ``|grad s|`` at the ``k = 1`` mesh's vertices, an estimate: hence not proven.
+
+    >>> import numpy as np
+    >>> from splinevis.volume.isosurface import Isosurface
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> z, y, x = np.mgrid[-1:1:20j, -1:1:20j, -1:1:20j]
+    >>> s = VolumeSpline(np.sqrt(x**2 + y**2 + z**2), spacing=(2 / 19,) * 3, origin=(-1, -1, -1))
+    >>> cache = {}
+    >>> [round(mesh_normal_error_deg(Isosurface(s, 0.7), None, k, cache)[0], 1) for k in (1, 4, 16)]
+    [29.4, 6.3, 1.5]
+    """
+    c = _bounds(surface, cache)
+    if len(c["hessian"]) == 0:
+        return 0.0, False
+    h = np.asarray(surface.spline.spacing, dtype=np.float64) / k
+    delta = c["hessian"] * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)
+    g = c["gradient"]
+    if not g > 0:
+        return float("inf"), False
+    radians = float((c["hessian"] / g * (np.sqrt((h ** 2).sum()) + delta / g)).max())
+    return float(np.degrees(min(radians, np.pi))), False
+
+
 def _mesh_triangles(surface, k, cache):
     from .sampled_mesh import MAX_FINE_POINTS, fine_points
 
@@ -97,6 +133,7 @@ def _mesh_refuses(surface, style):
 
 #: The isosurface's renderers (module docstring), declared on :data:`splinevis.volume.program.PROGRAM`.
 RENDERERS = (
-    Renderer("mesh", 0, MESH_LEVELS[:8], mesh_error_px, _mesh_build, _mesh_triangles, _mesh_refuses),
+    Renderer("mesh", 0, MESH_LEVELS[:8], mesh_error_px, _mesh_build, _mesh_triangles, _mesh_refuses,
+             normal_error_deg=mesh_normal_error_deg),
     Renderer("raycast", 10, exact=True),
 )
