@@ -64,6 +64,11 @@ class Renderer:
         exact renderer evaluates the spline's own normal per pixel (``exact normals``: float32 rounding only,
         which the program's hard cases compare with its float64 twin); a mesh's is unknown and never meets a
         ``max_normal_error_deg`` request.
+    measure : callable, optional
+        ``measure(model, view, level, cache) -> (pixels, degrees)``: the error measured against the float64
+        spline on samples of what the renderer draws (the points it draws against the spline points they stand
+        for, in pixels of ``view``; the normals it shades with against the spline's): what the benchmarks and
+        tests compare with the declared bounds. None: not measured.
 
     Examples
     --------
@@ -83,6 +88,7 @@ class Renderer:
     exact: bool = False
     program_options: tuple = ()
     normal_error_deg: Callable | None = None
+    measure: Callable | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():

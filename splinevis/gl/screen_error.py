@@ -113,6 +113,27 @@ class View:
         m = cam.GetCompositeProjectionTransformMatrix(self.width / self.height, -1, 1)
         return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
 
+    def pixel_distance(self, a, b) -> np.ndarray:
+        """Distance in pixels between the projections of the world points ``a`` and ``b`` (n, 3 each): the
+        screen-space error measured where ``a`` is drawn for ``b``; NaN where either is outside the view
+        frustum (behind the eye, beyond the clipping range or the window's sides).
+
+        >>> v = View((0, 0, 10), (0, 0, 0), (0, 1, 0), 90.0, width=200, height=200)
+        >>> v.pixel_distance([[0.0, 0, 0], [0, 0, 0]], [[0.1, 0, 0], [0, 0, 20]]).round(6)  # 10 px per unit at depth 10
+        array([ 1., nan])
+        """
+        m = self.matrix()
+        out = []
+        for p in (a, b):
+            p = np.asarray(p, dtype=np.float64).reshape(-1, 3)
+            h = p @ m[:, :3].T + m[:, 3]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ndc = h[:, :3] / h[:, 3:4]
+            inside = (h[:, 3] > 0) & (np.abs(ndc) <= 1.0).all(axis=1)
+            xy = np.column_stack([(ndc[:, 0] + 1.0) * 0.5 * self.width, (ndc[:, 1] + 1.0) * 0.5 * self.height])
+            out.append(np.where(inside[:, None], xy, np.nan))
+        return np.linalg.norm(out[0] - out[1], axis=1)
+
     def point_pixels(self, points, err) -> np.ndarray:
         """Pixels a world displacement of length ``err`` at ``points`` (n, 3) can move their projection by
         (module docstring); inf for visible points within ``err`` of the eye plane, 0 behind the eye.

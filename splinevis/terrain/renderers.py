@@ -24,7 +24,7 @@ import numpy as np
 from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "mesh_normal_error_deg", "RENDERERS"]
+__all__ = ["mesh_error_px", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
 
 
 def _boxes_and_hessian(terrain, cache):
@@ -83,6 +83,54 @@ def mesh_normal_error_deg(terrain, view, k, cache):
     return float(np.degrees(min(radians, np.pi))), True
 
 
+def mesh_measure(terrain, view, k, cache, samples: int = 20_000, seed: int = 0):
+    """(pixels, degrees) measured on the ``k x k`` sampled mesh against the float64 spline at ``samples``
+    random ``(x, y)``: the mesh point drawn there against the spline point ``(x, y, s(x, y))`` it stands for
+    (their projections' distance in ``view``, :meth:`~splinevis.gl.screen_error.View.pixel_distance`; points
+    outside the view skipped), and the normalized interpolated vertex normal against the spline's normal.
+
+    >>> import numpy as np
+    >>> from splinevis.gl.screen_error import View
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:17, 0:17] / 16.0
+    >>> t = TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
+    >>> v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 5))
+    >>> px, deg = mesh_measure(t, v, 2, {})
+    >>> bool(px <= mesh_error_px(t, v, 2, {})[0]), bool(deg <= mesh_normal_error_deg(t, v, 2, {})[0])
+    (True, True)
+    """
+    rng = np.random.default_rng(seed)
+    x0, x1, y0, y1 = terrain.extent
+    x, y = rng.uniform(x0, x1, samples), rng.uniform(y0, y1, samples)
+    u, v = terrain.to_index(x, y)
+    ncy, ncx = terrain.shape
+    a = np.minimum(np.floor(u * k), k * ncx - 1)
+    b = np.minimum(np.floor(v * k), k * ncy - 1)
+    lu, lv = u * k - a, v * k - b
+    upper = lv > lu  # the sub-square's triangles (00, 10, 11) and (00, 11, 01), split along u = v
+    corners = [(a, b), (a + 1, b + 1), (np.where(upper, a, a + 1), np.where(upper, b + 1, b))]
+    weights = [1.0 - np.maximum(lu, lv), np.minimum(lu, lv), np.abs(lu - lv)]
+    sx, sy = (float(s) for s in terrain.cell_spacing)
+    z = np.zeros(samples)
+    n = np.zeros((samples, 3))
+    for (ca, cb), w in zip(corners, weights):
+        cu, cv = ca / k, cb / k
+        xv, yv = terrain.origin[0] + cu * sx, terrain.origin[1] + cv * sy
+        z += w * terrain.height_at_index(cu, cv)
+        g = terrain.gradient(xv, yv)
+        nv = np.column_stack([-g[:, 0], -g[:, 1], np.ones(samples)])
+        n += w[:, None] * nv / np.linalg.norm(nv, axis=1, keepdims=True)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    g = terrain.gradient(x, y)
+    exact = np.column_stack([-g[:, 0], -g[:, 1], np.ones(samples)])
+    exact /= np.linalg.norm(exact, axis=1, keepdims=True)
+    drawn = np.column_stack([x, y, terrain.z_ref + z])
+    spline = np.column_stack([x, y, terrain.evaluate(x, y)])
+    px = view.pixel_distance(drawn, spline)
+    deg = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", n, exact), -1.0, 1.0)))
+    return (float(np.nanmax(px)) if np.isfinite(px).any() else 0.0), float(deg.max())
+
+
 def _mesh_triangles(terrain, k, cache):
     from .sampled_mesh import mesh_triangles
 
@@ -98,7 +146,7 @@ def _mesh_build(plotter, terrain, style, k, cache, spline_options, add_options):
 #: The terrain's renderers (module docstring), declared on :data:`splinevis.terrain.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, _mesh_triangles, mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
     Renderer("mesh_guided", 15, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1}),
     Renderer("raycast", 10, exact=True),
 )

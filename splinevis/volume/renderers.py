@@ -22,7 +22,7 @@ import numpy as np
 from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "mesh_normal_error_deg", "RENDERERS"]
+__all__ = ["mesh_error_px", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
 
 
 def _mesh1(surface, cache):
@@ -108,6 +108,50 @@ def mesh_normal_error_deg(surface, view, k, cache):
     return float(np.degrees(min(radians, np.pi))), False
 
 
+def mesh_measure(surface, view, k, cache, samples: int = 20_000, seed: int = 0):
+    """(pixels, degrees) measured on the mesh at ``k`` samples per cube against the float64 spline: at
+    ``samples`` random points of its triangles (a random triangle each, random barycentric weights), the
+    drawn point against the surface point it stands for (Newton steps along the gradient onto the
+    isosurface), their projections' distance in ``view``, and the normalized interpolated vertex normal
+    against the spline's normal there.
+
+    >>> import numpy as np
+    >>> from splinevis.gl.screen_error import View
+    >>> from splinevis.volume.isosurface import Isosurface
+    >>> from splinevis.volume.model import VolumeSpline
+    >>> z, y, x = np.mgrid[-1:1:20j, -1:1:20j, -1:1:20j]
+    >>> s = VolumeSpline(np.sqrt(x**2 + y**2 + z**2), spacing=(2 / 19,) * 3, origin=(-1, -1, -1))
+    >>> v = View((3, -4, 2), (0, 0, 0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 20))
+    >>> surface, cache = Isosurface(s, 0.7), {}
+    >>> px, deg = mesh_measure(surface, v, 2, cache)
+    >>> bool(0 < px <= mesh_error_px(surface, v, 2, cache)[0]), bool(0 < deg <= mesh_normal_error_deg(surface, v, 2, cache)[0])
+    (True, True)
+    """
+    from .sampled_mesh import sampled_mesh
+
+    mesh = cache.get(("mesh", k))
+    if mesh is None:
+        mesh = cache["mesh", k] = sampled_mesh(surface.spline, surface.isovalue, k, surface.relevant)
+    if mesh.n_cells == 0:
+        return 0.0, 0.0
+    rng = np.random.default_rng(seed)
+    tri = mesh.faces.reshape(-1, 4)[:, 1:][rng.integers(0, mesh.n_cells, samples)]
+    w = rng.dirichlet([1.0, 1.0, 1.0], samples)
+    drawn = np.einsum("tk,tkc->tc", w, np.asarray(mesh.points, dtype=np.float64)[tri])
+    n = np.einsum("tk,tkc->tc", w, np.asarray(mesh.point_data["Normals"], dtype=np.float64)[tri])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    iso, spline = surface.isovalue, surface.spline
+    q = drawn.copy()
+    for _ in range(8):  # Newton along the gradient: quadratic convergence from within a fine cell
+        val, g = spline.evaluate(q, gradient=True)
+        q -= ((val - iso) / np.maximum(np.einsum("ij,ij->i", g, g), 1e-300))[:, None] * g
+    _, g = spline.evaluate(q, gradient=True)
+    exact = g / np.linalg.norm(g, axis=1, keepdims=True)
+    px = view.pixel_distance(drawn, q)
+    deg = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", n, exact), -1.0, 1.0)))
+    return (float(np.nanmax(px)) if np.isfinite(px).any() else 0.0), float(deg.max())
+
+
 def _mesh_triangles(surface, k, cache):
     from .sampled_mesh import MAX_FINE_POINTS, fine_points
 
@@ -134,6 +178,6 @@ def _mesh_refuses(surface, style):
 #: The isosurface's renderers (module docstring), declared on :data:`splinevis.volume.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS[:8], mesh_error_px, _mesh_build, _mesh_triangles, _mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
     Renderer("raycast", 10, exact=True),
 )
