@@ -5,8 +5,9 @@
   vertical chord <= M h^2 / 4 per cell (h = 1/k, M the Hessian bound from the BB second differences), plus
   the float32 rounding of the vertices (:func:`splinevis.gl.renderers.float32_margin`), turned into pixels
   over each cell's box (:meth:`splinevis.gl.screen_error.View.box_pixels`); rank 0. Its normals are the
-  spline's at the vertices, interpolated: **proven** within ``||H|| l`` radians of the spline's normal at
-  the same ``(x, y)`` (:func:`mesh_normal_error_deg`).
+  spline's at the vertices, interpolated: **proven** within the smaller of a first-order (``||H|| l``) and a
+  second-order (third derivatives, ``l^2``) bound of the spline's normal at the same ``(x, y)``
+  (:func:`mesh_normal_error_deg`; C1 schemes).
 * ``mesh_guided``: the program with ``proxy="mesh"`` (:mod:`splinevis.terrain.mesh_proxy`), the same picture
   as the box ray cast (the same hard cases agree with the float64 twin), the ray cast's error. It was 2.5-4x
   cheaper than the box ray cast; since the box ray cast walks its cells in rounds (4x faster,
@@ -24,7 +25,7 @@ import numpy as np
 from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
+__all__ = ["mesh_error_px", "third_derivative_bounds", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
 
 
 def _boxes_and_hessian(terrain, cache):
@@ -55,31 +56,78 @@ def mesh_error_px(terrain, view, k, cache):
     return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, True
 
 
+def third_derivative_bounds(coefficients) -> np.ndarray:
+    """(ncy, ncx) bound of every third partial derivative's magnitude (index coordinates u, v; heights as
+    stored) over each cell: ``D_a D_b D_c f`` of a quartic piece is linear with BB coefficients
+    ``24 (Delta_a Delta_b Delta_c c)`` (third differences along the barycentric directions of u and v), so
+    by the convex hull property its largest coefficient magnitude bounds it; the largest over the four
+    partials and the cell's two triangles.
+
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> y, x = np.mgrid[0:6, 0:6].astype(float)
+    >>> t = TerrainSpline.from_heights(x ** 3 / 6.0, "C1")   # f = u^3 / 6 (C1 reproduces cubics): f_uuu = 1
+    >>> bool(np.allclose(third_derivative_bounds(t.coefficients), 1.0))
+    True
+    """
+    from ..bb import simplex
+    from .model import _DLAM_DU, _DLAM_DV
+
+    c = np.asarray(coefficients, dtype=np.float64)
+    out = np.zeros(c.shape[:-2])
+    for dirs in ((_DLAM_DU,) * 3, (_DLAM_DU, _DLAM_DU, _DLAM_DV), (_DLAM_DU, _DLAM_DV, _DLAM_DV), (_DLAM_DV,) * 3):
+        for tri in (0, 1):
+            d = c[..., tri, :]
+            for a in dirs:
+                d = simplex.derivative(d, a[tri], d=2)
+            out = np.maximum(out, np.abs(d).max(axis=-1))
+    return out
+
+
 def mesh_normal_error_deg(terrain, view, k, cache):
     """(degrees, True): the largest angle between the normal the ``k x k`` sampled mesh shades with and the
-    spline's normal at the same ``(x, y)``, over all cells.
+    spline's normal at the same ``(x, y)``, over all cells; (inf, False) for schemes that are not C1 (the
+    normal jumps across cell edges, so a vertex has no single normal).
 
-    Derivation. The normal of the graph ``z = f(x, y)`` is ``n = g / |g|``, ``g = (-f_x, -f_y, 1)``, so
-    ``dn = (I - n n^T) dg / |g|`` and ``|dn| <= |dg| <= ||H|| |dp|`` (``|g| >= 1``; ``H`` the world Hessian,
-    ``||H|| <= M / min(s_x, s_y)^2`` with ``M`` the index-unit bound of :mod:`.sampled_mesh` and ``s`` the cell
-    spacing). The angle between ``n(p)`` and a vertex normal ``n_i`` is at most the length of the path of ``n``
-    along the segment, ``||H|| |p - p_i| <= ||H|| l`` with ``l = sqrt(s_x^2 + s_y^2) / k`` the sub-triangles'
-    longest side. The rasterizer shades with a normalized convex combination of the ``n_i``; all lie in the
-    spherical cap of that radius around ``n(p)``, which is convex while the radius is below 90 degrees, so the
-    shading normal is in it too. Float32 rounding of the unit normals adds ``8 u`` radians.
+    Derivation. On a sub-triangle (inside one polynomial piece) the normal of the graph ``z = f(x, y)`` is
+    ``n = phi / |phi|``, ``phi = (-f_x, -f_y, 1)``, ``|phi| >= 1``; world bounds: ``|phi'| <= M`` (the Hessian's
+    spectral norm, ``M_index / min(s)^2``) and ``|phi''| <= 2 sqrt(2) T`` (``T`` the largest third partial,
+    :func:`third_derivative_bounds` over ``min(s)^3``; ``|D_d^2 f_x| <= (|d_x| + |d_y|)^2 T <= 2 T``) along any
+    unit direction, ``s`` the cell spacing. Two bounds, the smaller is used:
+
+    * first order: ``|n'| <= |phi'| / |phi| <= M``, so every vertex normal ``n_i`` is within ``M l`` radians of
+      ``n(p)`` (``l = sqrt(s_x^2 + s_y^2) / k``, the sub-triangles' longest side);
+    * second order: ``|n''| <= 2 |phi''| + 6 |phi'|^2 =: K`` (differentiating ``phi / |phi|`` twice), and
+      Taylor's formula at ``p`` with ``sum lam_i (p_i - p) = 0`` gives ``|n(p) - sum lam_i n_i| <= K R^2 / 2``
+      (``R^2 = l^2 / 4`` the right sub-triangle's circumradius squared, ``sum lam_i |p_i - p|^2 <= R^2``), and a
+      vector within ``e < 1`` of the unit ``n(p)`` is within ``asin(e)`` of its direction.
+
+    The rasterizer shades with a normalized convex combination of the ``n_i``: in the first case it lies in the
+    spherical cap of that radius around ``n(p)`` (convex below 90 degrees), in the second its direction is the
+    combination's. Float32 rounding of the unit normals adds ``8 u`` radians.
 
     >>> import numpy as np
     >>> from splinevis.terrain.model import TerrainSpline
     >>> y, x = np.mgrid[0:17, 0:17] / 16.0
     >>> t = TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
-    >>> [round(mesh_normal_error_deg(t, None, k, {})[0], 2) for k in (1, 4, 16)]  # falls as 1 / k
-    [28.5, 7.13, 1.78]
+    >>> [round(mesh_normal_error_deg(t, None, k, {})[0], 3) for k in (1, 4, 16)]  # second order once k is large
+    [24.879, 1.507, 0.094]
     """
     from ..gl.error_bounds import U32
+    from .mesh_proxy import C1_SCHEMES
 
+    if terrain.scheme not in C1_SCHEMES:
+        return float("inf"), False
     _, M = _boxes_and_hessian(terrain, cache)
+    if "third" not in cache:
+        cache["third"] = third_derivative_bounds(terrain.coefficients).reshape(-1)
     sx, sy = (float(v) for v in terrain.cell_spacing)
-    radians = float(M.max()) / min(sx, sy) ** 2 * np.hypot(sx, sy) / k + 8.0 * U32
+    hw = M / min(sx, sy) ** 2  # per cell
+    tw = cache["third"] / min(sx, sy) ** 3
+    l = np.hypot(sx, sy) / k
+    first = hw * l
+    e = (2.0 * 2.0 * np.sqrt(2.0) * tw + 6.0 * hw * hw) * l * l / 8.0
+    second = np.where(e < 1.0, np.arcsin(np.minimum(e, 1.0)), np.inf)
+    radians = float(np.minimum(first, second).max()) + 8.0 * U32
     return float(np.degrees(min(radians, np.pi))), True
 
 
