@@ -417,21 +417,22 @@ class Plotter(pv.Plotter):
         """
         return self._add_from("nurbs", (model,), None, style, options)
 
-    def add_geometry_image(self, surface, style: Style | None = None, *, n="auto", level: float = 3.0,
-                           fairness="auto", displacement=None, backend: str = "gpu", **options):
+    def add_geometry_image(self, surface, style: Style | None = None, *, n="auto", level: float = 3.0, fairness="auto",
+                           displacement=None, backend="gpu", max_error_px=None, max_normal_error_deg=None, **options):
         """Draw a closed genus-0 surface as a smooth geometry image [Losasso2003]: one bicubic B-spline on an
         octahedral image, subdivided by GPU passes to the continuous ``level`` of detail, with exact normals.
 
-        ``surface`` is a :class:`~splinevis.geometry_image.GeometryImage`, or a closed genus-0 triangle mesh
-        (pyvista PolyData or any file pyvista reads), parametrized on the sphere and fitted with an ``n x n``
-        image (``n="auto"``: the smallest of 33, 65, 129, 257 within 0.5 % of the diagonal of the mesh, measured;
-        warnings of folds and of detail it cannot resolve reach the caller) with ``fairness`` ("auto": 0.1, stronger
-        while the surface folds, :func:`splinevis.geometry_image.build.geometry_image_from_mesh`) first (a mesh that is not closed, manifold, connected and of genus 0 raises
-        :class:`splinevis.errors.MeshTopologyError` saying which check failed and where). ``displacement``:
-        a scalar map on the output grid (:func:`splinevis.geometry_image.program.displacement_map`);
-        ``backend="numpy"`` subdivides with the float64 twin. Other keywords are effects (see
-        :meth:`add_spline`); reflection lines, isophotes and curvature use the surface's exact normals and
-        curvature. Returns the vtkActor of the mesh.
+        ``surface`` is a :class:`~splinevis.geometry_image.GeometryImage`, or a closed genus-0 triangle mesh (pyvista
+        PolyData or any file pyvista reads), parametrized on the sphere and fitted with an ``n x n`` image
+        (``n="auto"``: the smallest of 33, 65, 129, 257 within 0.5 % of the diagonal of the mesh, measured; warnings
+        of folds and of detail it cannot resolve reach the caller) with ``fairness`` ("auto": 0.1, stronger while the
+        surface folds, :func:`splinevis.geometry_image.build.geometry_image_from_mesh`) first (a mesh that is not
+        closed, manifold, connected and of genus 0 raises :class:`splinevis.errors.MeshTopologyError` saying which
+        check failed and where). ``displacement``: a scalar map on the output grid
+        (:func:`splinevis.geometry_image.program.displacement_map`); ``backend="numpy"`` subdivides with the float64
+        twin. Other keywords are effects (see :meth:`add_spline`); reflection lines, isophotes and curvature use the
+        surface's exact normals and curvature. ``max_error_px``, ``max_normal_error_deg``: the level is chosen
+        (:func:`.geometry_image.renderers.add_by_accuracy`). Returns the vtkActor of the mesh.
 
         Examples
         --------
@@ -442,10 +443,11 @@ class Plotter(pv.Plotter):
         (1089, True)
         >>> pl.close()
         """
+        from .geometry_image.renderers import add_by_accuracy
         from .programs import get
-
-        program = get("geometry_image")
-        model = program.model_from(surface, n, fairness=fairness)
+        model = get("geometry_image").model_from(surface, n, fairness=fairness)
+        if max_error_px is not None or max_normal_error_deg is not None:
+            return add_by_accuracy(self, model, style, options, max_error_px, max_normal_error_deg, displacement, backend)
         return self.add_spline(model, style, program_options={"level": level, "displacement": displacement,
                                                               "backend": backend}, **options)
 

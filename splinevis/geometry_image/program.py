@@ -29,6 +29,7 @@ import numpy as np
 
 from ..gl.contract import HardCase, SplineProgram
 from .model import GeometryImage
+from .renderers import RENDERERS
 
 __all__ = ["surface_arrays", "surface_mesh", "displacement_map", "model_from", "min_level", "PROGRAM"]
 
@@ -233,5 +234,5 @@ def _build(model, style, *, newton_iterations, level=3.0, displacement=None, bac
 
 PROGRAM = SplineProgram(
     "geometry_image", "passes", GeometryImage, build=_build, model_from=model_from, hard_cases=_hard_cases,
-    options=("level", "displacement", "backend"),
+    options=("level", "displacement", "backend"), renderers=RENDERERS,
     description="smooth geometry images: one bicubic B-spline, GPU subdivision passes [Losasso2003]")
