@@ -59,7 +59,7 @@ from .gl.screen_error import SNAP_PX, View
 from .plotting_options import split_read_options
 
 __all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_for", "check_max_error", "check_requests",
-           "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px"]
+           "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px", "add_renderer"]
 
 log = logging.getLogger("splinevis")
 
@@ -372,8 +372,9 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     # meshes take no ray-cast options; a renderer with program options of its own (mesh-guided) sets them
     plain = {r.name for r in rows if r.build is None and not r.program_options}
     exclude = {r.name: f"{' and '.join(given)} given (ray-cast options)" for r in rows if given and r.name not in plain}
+    cache = {"add_options": dict(add_options or {})}  # the error functions may read how it will be drawn
     choice = choose(model, View.from_renderer(ren, plotter.window_size), max_error_px, style, program=prog,
-                    cache=(cache := {}), exclude=exclude, max_normal_error_deg=max_normal_error_deg)
+                    cache=cache, exclude=exclude, max_normal_error_deg=max_normal_error_deg)
     def build(c, options):
         entry = next(r for r in rows if r.name == c.renderer)
         return (entry.build or partial(_add_own, renderer=entry))(plotter, model, style, c.level, cache, options,
@@ -389,6 +390,33 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
                    lambda view: choose(model, view, max_error_px, style, program=prog, cache=cache, exclude=exclude,
                                        max_normal_error_deg=max_normal_error_deg))
     return actor
+
+
+def add_renderer(plotter, model, style, name: str, level=None, *, program=None, cache: dict | None = None):
+    """Draw ``model`` with its program's renderer ``name`` at ``level`` (what the choice would build for that
+    option): for benchmarks and studies that time or compare renderers side by side.
+
+    >>> import numpy as np
+    >>> from splinevis.effects import Style
+    >>> from splinevis.plotting import Plotter
+    >>> from splinevis.terrain.model import TerrainSpline
+    >>> t = TerrainSpline.from_heights(np.zeros((5, 5)), "C1")
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> add_renderer(pl, t, Style(), "mesh", 2).GetMapper().GetInput().GetNumberOfCells()  # 2 k^2 per cell
+    128
+    >>> pl.close()
+    """
+    from functools import partial
+
+    prog = _program(model, program)
+    rows, _ = renderers_for(prog)
+    entry = next((r for r in rows if r.name == name), None)
+    if entry is None:
+        raise ValueError(f"program {prog.name!r} has no renderer {name!r}; it has {[r.name for r in rows]}.")
+    cache = {} if cache is None else cache
+    cache["program"] = prog
+    build = entry.build or partial(_add_own, renderer=entry)
+    return build(plotter, model, style, level, cache, {}, None)
 
 
 def _set_attribute(actor, key, value):
