@@ -27,6 +27,7 @@ from ..gl.proxies import pack_rgba32f
 from ..gl.spec import ProgramSpec
 from .model import NurbsModel
 from .raycast import depth_bound, reference
+from .renderers import RENDERERS
 from .shell import model_offset, patch_facts, tessellate
 from .surface import NurbsSurface
 
@@ -169,4 +170,4 @@ PROGRAM = SplineProgram(
     name="nurbs", kind="surface", model_type=NurbsModel, build=_build, reference=reference, depth_bound=depth_bound,
     hard_cases=_hard_cases, model_from=model_from, root_methods=("newton",), newton_iterations=12,
     options=("subdivisions",), description="NURBS patches evaluated per fragment, Newton on the pixel ray [Kanai2007]",
-    converts=(NurbsSurface,))
+    converts=(NurbsSurface,), renderers=RENDERERS)

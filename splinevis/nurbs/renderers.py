@@ -1,0 +1,541 @@
+r"""The NURBS family's renderers for the choice by accuracy (``Plotter.add_nurbs(..., max_error_px=...,
+max_normal_error_deg=...)``, :mod:`splinevis.choice`), declared on its program as :data:`RENDERERS`.
+
+* ``mesh`` (rank 0): :func:`splinevis.nurbs.tessellate.tessellate` with ``k`` samples per knot span and
+  direction (each span quad split into the triangles ``(a, b, c)``, ``(a, c, d)``), vertex normals the exact
+  unit normals [Kanai2007, sec. 4, Fig. 3 left]. Its position error is **proven** (:func:`chord_bounds`: the
+  distance between each triangle and the surface point at the same ``(u, v)``, from second-derivative bounds
+  of the rational Bezier patches [Kumar1997, sec. 4.1]), plus the float32 rounding of the vertices
+  (:func:`splinevis.gl.renderers.float32_margin`), turned into pixels over the boxes of a fixed grid of cells
+  of each patch (:meth:`splinevis.gl.screen_error.View.box_pixels`). Its normal error is **proven**
+  (:func:`normal_bounds`: normal cones of the pseudo-Gauss map [Kumar1997, sec. 3], a first-order and a
+  second-order bound, the smallest per sub-square; poles are covered by the cones), infinite where none
+  holds: across a C0 crease (the shared vertices carry one side's normal: the mesh is really that far off)
+  or where ``S_u x S_v`` vanishes and no cone was computed; such a model never meets a normal request with
+  the mesh. Trimmed models are refused: the tessellation ignores trim loops.
+* ``per_fragment`` (rank 10, exact): the program itself (Newton on the pixel ray per fragment); its error is
+  the program's own, :func:`splinevis.choice.raycast_error_px` (an estimate from the float32 depth bound,
+  since the program has a float64 twin and a depth bound), with exact normals.
+
+Cost ranks: docs/results/nurbs/nurbs.md (640 x 480, Mesa llvmpipe, a hood panel with zebra stripes) measured
+the per-fragment program at 313 ms per frame against 16 ms for the 32-per-span mesh with exact vertex
+normals (31 ms at 64 per span): the mesh ranks 0, the program 10.
+
+Cells. Every Bezier patch of the model (:func:`splinevis.nurbs.lod.bezier.bezier_set`: the knot spans the
+tessellation cuts) is cut once into ``r x r`` cells of its local domain ``[0, 1]^2`` (``r`` from 16 down to 2
+so that the model has at most :data:`CELL_BUDGET` cells); on each cell the Bernstein net of the sub-patch
+(:func:`splinevis.nurbs.lod.bounds.subdivide`) gives bounds of the surface's first and second derivatives
+and of the pseudo-Gauss map, valid for every ``k``: a sub-square of level ``k`` (side ``1 / k``) lies in the
+cells its interior meets (a contiguous range per direction), so its bounds are the maxima over that range.
+Cells are widened by the rounding of the tessellation's parameters (:func:`splinevis.nurbs.basis.at_fraction`
+in the parent's parameters, a few ``eps (|u0| + |u1|) / (u1 - u0)`` in local ones), so that the vertices'
+actual parameters lie in them too.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..gl.error_bounds import U32
+from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
+from ..gl.screen_error import SNAP_PX
+from .model import NurbsModel
+from .surface import NurbsSurface
+
+__all__ = ["CELL_BUDGET", "CONE_BUDGET", "chord_bounds", "normal_bounds", "mesh_error_px", "mesh_normal_error_deg",
+           "mesh_triangles", "nurbs_mesh_refuses", "RENDERERS"]
+
+EPS = np.finfo(float).eps
+#: Most cells a model is cut into for the bounds (each patch ``r x r``, ``2 <= r <= 16``).
+CELL_BUDGET = 65_536
+#: Most level-``k`` sub-patches whose normal cones are computed directly (about 20 us each); beyond, the
+#: first-order normal bound alone (:func:`normal_bounds`).
+CONE_BUDGET = 65_536
+_CHUNK = 4096  # boxes per block of subdivision (bounded memory for degree 7)
+
+
+def _model(model) -> NurbsModel:
+    return NurbsModel([model], source=model.name) if isinstance(model, NurbsSurface) else model
+
+
+def _bezier(model, cache):
+    from .lod.bezier import bezier_set
+
+    if "nurbs_bezier" not in cache:
+        bs = bezier_set(_model(model))
+        rect = bs.rect
+        # local widening: the rounding of at_fraction's a + t (b - a) (and of its clamp) in the parent's parameters
+        du = 4 * EPS * (np.abs(rect[:, 0]) + np.abs(rect[:, 1])) / (rect[:, 1] - rect[:, 0]) + 4 * EPS
+        dv = 4 * EPS * (np.abs(rect[:, 2]) + np.abs(rect[:, 3])) / (rect[:, 3] - rect[:, 2]) + 4 * EPS
+        cache["nurbs_bezier"] = (bs, np.column_stack([du, dv]))
+    return cache["nurbs_bezier"]
+
+
+def _grid_boxes(n: int, widen: np.ndarray) -> np.ndarray:
+    """``(N, n, n, 4)`` boxes ``(u0, u1, v0, v1)`` of the ``n x n`` grid of ``[0, 1]^2``, widened by ``widen (N, 2)``
+    and clipped to ``[0, 1]``."""
+    a, b = np.arange(n) / n, (np.arange(n) + 1.0) / n
+    u0 = np.clip(a[None, :] - widen[:, :1], 0.0, 1.0)
+    u1 = np.clip(b[None, :] + widen[:, :1], 0.0, 1.0)
+    v0 = np.clip(a[None, :] - widen[:, 1:], 0.0, 1.0)
+    v1 = np.clip(b[None, :] + widen[:, 1:], 0.0, 1.0)
+    N = widen.shape[0]
+    box = np.empty((N, n, n, 4))
+    box[..., 0], box[..., 1] = u0[:, :, None], u1[:, :, None]
+    box[..., 2], box[..., 3] = v0[:, None, :], v1[:, None, :]
+    return box
+
+
+def _sub_nets(C: np.ndarray, box: np.ndarray):
+    """Yield ``(rows, Q)``: the Bernstein nets ``Q (B, m + 1, n + 1, 4)`` of the patches ``C (N, ...)`` on
+    ``box (N, n, n, 4)``, flattened (patch-major), in blocks of at most ``_CHUNK``."""
+    from .lod.bounds import subdivide
+
+    N, g = box.shape[0], box.shape[1] * box.shape[2]
+    item = np.repeat(np.arange(N), g)
+    flat = box.reshape(-1, 4)
+    for a in range(0, flat.shape[0], _CHUNK):
+        rows = slice(a, min(a + _CHUNK, flat.shape[0]))
+        yield rows, subdivide(C[item[rows]], flat[rows])
+
+
+def _diff_norm(Q: np.ndarray, axis: int, order: int) -> np.ndarray:
+    """``max |Delta^order Q|`` along ``axis`` (1: s, 2: t) per net ``(B, ., ., c)`` (0 if the degree is lower)."""
+    if Q.shape[axis] <= order:
+        return np.zeros(Q.shape[0])
+    D = np.diff(Q, n=order, axis=axis)
+    return np.linalg.norm(D, axis=-1).reshape(Q.shape[0], -1).max(axis=1)
+
+
+def _cell_derivatives(Q: np.ndarray, size: np.ndarray, mag: np.ndarray) -> dict:
+    """Bounds over each cell of ``|F_u|, |F_v|`` (``f``, (B, 2)) and ``|F_uu|, |F_uv|, |F_vv|`` (``M``, (B, 3)) in the
+    patch's local parameters, the hull box ``lo, hi`` of the cell's control points, from its nets ``Q`` and the cell
+    sizes ``size (B, 2)`` and the magnitudes ``mag (B, 2)`` (largest ``|w P|`` and ``w``) of their patches' nets
+    (derivation: :func:`chord_bounds`); also the nets shifted to the cells' centres."""
+    m, n = Q.shape[1] - 1, Q.shape[2] - 1
+    B = Q.shape[0]
+    w = Q[..., 3]
+    P = Q[..., :3] / w[..., None]
+    Pf = P.reshape(B, -1, 3)
+    lo, hi = Pf.min(axis=1), Pf.max(axis=1)
+    c = 0.5 * (lo + hi)
+    R = np.linalg.norm(Pf - c[:, None, :], axis=-1).max(axis=1)
+    A = Q[..., :3] - c[:, None, None, :] * w[..., None]
+    # rounding (worst case, [Higham2002, sec. 3.1]): the subdivided coefficients are convex combinations of the
+    # patch's, off by (m + n + 4) eps times the patch's largest; forming A adds |c| times the weight's error
+    eW = (m + n + 4) * EPS * mag[:, 1]
+    eQ = 2.0 * (m + n + 4) * EPS * mag[:, 0] + 2.0 * np.linalg.norm(c, axis=1) * eW
+    wmin = w.reshape(B, -1).min(axis=1) - eW
+    R = R + 2.0 * eQ / wmin
+    W = w[..., None]
+    a1 = m * (_diff_norm(A, 1, 1) + 2 * eQ)
+    a2 = n * (_diff_norm(A, 2, 1) + 2 * eQ)
+    b1 = m * (_diff_norm(W, 1, 1) + 2 * eW)
+    b2 = n * (_diff_norm(W, 2, 1) + 2 * eW)
+    mixed = lambda X: np.linalg.norm(np.diff(np.diff(X, axis=1), axis=2), axis=-1).reshape(B, -1).max(axis=1)  # noqa: E731
+    a11 = m * (m - 1) * (_diff_norm(A, 1, 2) + 4 * eQ)
+    a22 = n * (n - 1) * (_diff_norm(A, 2, 2) + 4 * eQ)
+    a12 = m * n * (mixed(A) + 4 * eQ)
+    b11 = m * (m - 1) * (_diff_norm(W, 1, 2) + 4 * eW)
+    b22 = n * (n - 1) * (_diff_norm(W, 2, 2) + 4 * eW)
+    b12 = m * n * (mixed(W) + 4 * eW)
+    f1, f2 = (a1 + b1 * R) / wmin, (a2 + b2 * R) / wmin
+    M1 = (a11 + b11 * R + 2.0 * b1 * f1) / wmin
+    M2 = (a12 + b12 * R + b1 * f2 + b2 * f1) / wmin
+    M3 = (a22 + b22 * R + 2.0 * b2 * f2) / wmin
+    hs, ht = size[:, 0], size[:, 1]
+    slack = 1.0 + 1e-12  # the arithmetic of the lines above: a few roundings, relative
+    M = np.column_stack([M1 / (hs * hs), M2 / (hs * ht), M3 / (ht * ht)]) * slack
+    return {"M": M, "f": np.column_stack([f1 / hs, f2 / ht]) * slack, "lo": lo, "hi": hi,
+            "shifted": np.concatenate([A, W], axis=-1)}
+
+
+def _cell_normals(Q: np.ndarray, size: np.ndarray):
+    """``(B, 5)`` bounds of ``|n_u|, |n_v|, |n_uu|, |n_uv|, |n_vv|`` over each cell (patch-local parameters; inf
+    where the cell's pseudo-Gauss net has no cone or touches zero), derivation: :func:`normal_bounds`; the net's four side
+    rows ``(B, 4, d + 1, 3)`` (s = 0, s = 1, t = 0, t = 1: the one-sided normals along the cell's sides)."""
+    from .lod.gauss import normal_cone, pseudo_gauss_net
+
+    G = pseudo_gauss_net(Q, rational=True)  # one degree for every net of a group (the seams compare them)
+    B, a, b = G.shape[0], G.shape[1] - 1, G.shape[2] - 1
+    axis, half = normal_cone(G.reshape(B, -1, 3))
+    g = np.einsum("bklc,bc->bkl", G, axis).reshape(B, -1).min(axis=1)
+    g1, g2 = a * _diff_norm(G, 1, 1), b * _diff_norm(G, 2, 1)
+    mixed = np.linalg.norm(np.diff(np.diff(G, axis=1), axis=2), axis=-1).reshape(B, -1).max(axis=1)
+    g11, g12, g22 = a * (a - 1) * _diff_norm(G, 1, 2), a * b * mixed, b * (b - 1) * _diff_norm(G, 2, 2)
+    ok = (half < 0.5 * math.pi) & (g > 0)
+    hs, ht = size[:, 0], size[:, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        nu, nv = g1 / g, g2 / g
+        out = np.column_stack([nu / hs, nv / ht, (2 * g11 + 3 * g1 * nu) / g / (hs * hs),
+                               (2 * g12 + 3 * g1 * nv) / g / (hs * ht), (2 * g22 + 3 * g2 * nv) / g / (ht * ht)])
+    return np.where(ok[:, None], out, np.inf), (G[:, 0], G[:, -1], G[:, :, 0], G[:, :, -1])
+
+
+def _square(Q: np.ndarray) -> np.ndarray:
+    """The nets ``Q (B, m + 1, n + 1, 4)`` degree-raised to ``max(m, n)`` in both directions (the same surface
+    [Farin2002, ch. 5]), so that the side rows of every net of a group have one length."""
+    for axis in (1, 2):
+        while Q.shape[axis] < max(Q.shape[1], Q.shape[2]):
+            m = Q.shape[axis] - 1
+            a = (np.arange(m + 2) / (m + 1)).reshape((1, -1, 1, 1) if axis == 1 else (1, 1, -1, 1))
+            lo = np.concatenate([np.zeros_like(np.take(Q, [0], axis=axis)), Q], axis=axis)
+            hi = np.concatenate([Q, np.zeros_like(np.take(Q, [0], axis=axis))], axis=axis)
+            Q = a * lo + (1.0 - a) * hi
+    return Q
+
+
+def _product(a: np.ndarray, b: np.ndarray, op) -> np.ndarray:
+    """Bernstein coefficients ``(S, 2d + 1, c)`` of ``op(a(t), b(t))`` for curves ``a, b (S, d + 1, 3)`` (``op``:
+    the cross or the dot product, ``c`` components), by the product rule of Bernstein forms [Farin2002, ch. 5]."""
+    from math import comb
+
+    d = a.shape[1] - 1
+    out = None
+    for i in range(d + 1):
+        for j in range(d + 1):
+            term = (comb(d, i) * comb(d, j) / comb(2 * d, i + j)) * op(a[:, i], b[:, j])
+            if out is None:
+                out = np.zeros((a.shape[0], 2 * d + 1, term.shape[-1]))
+            out[:, i + j] += term
+    return out
+
+
+def _seam_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Bounds ``(S,)`` of the angle between the one-sided normals ``a(t)``, ``b(t)`` (pseudo-Gauss side curves
+    ``(S, d + 1, 3)`` of two patches along their common side), derivation: :func:`normal_bounds`."""
+    from .lod.gauss import normal_cone
+
+    dot = lambda x, y: np.einsum("...c,...c->...", x, y)[..., None]  # noqa: E731
+    c = np.linalg.norm(_product(a, b, np.cross), axis=-1).max(axis=-1)
+    ab = _product(a, b, dot)[..., 0].min(axis=-1)
+    size = np.linalg.norm(a, axis=-1).max(axis=-1) * np.linalg.norm(b, axis=-1).max(axis=-1)
+    tol = 1e-12 * size
+    parallel = (c <= tol) & (ab >= -tol)  # a x b = 0 and a . b >= 0 up to rounding: the same normals (G1)
+    amin = np.einsum("skc,sc->sk", a, normal_cone(a)[0]).min(axis=-1)
+    bmin = np.einsum("skc,sc->sk", b, normal_cone(b)[0]).min(axis=-1)
+    ok = (amin > 0) & (bmin > 0) & (ab > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angle = np.arcsin(np.minimum(1.0, c / (amin * bmin)))
+    return np.where(parallel, 0.0, np.where(ok, angle, np.inf))
+
+
+def _seams(bs, ids, sides, r) -> np.ndarray:
+    """``(len(ids),)`` twice the largest seam angle of each patch's surface (0 for a single patch)."""
+    out = np.zeros(len(ids))
+    pos = {int(i): k for k, i in enumerate(ids)}
+    for parent in np.unique(bs.parent[ids]):
+        mine = np.flatnonzero(bs.parent == parent)
+        rect = bs.rect[mine]
+        nu, nv = np.unique(rect[:, 0]).size, np.unique(rect[:, 2]).size
+        grid = np.array([pos[int(i)] for i in mine]).reshape(nu, nv)  # u-major (bezier_set)
+        phi = [np.zeros(0)]
+        if nu > 1:  # s = 1 of patch (I, J) against s = 0 of (I + 1, J)
+            phi.append(_seam_angle(sides[1][grid[:-1]].reshape((-1,) + sides[1].shape[2:]),
+                                   sides[0][grid[1:]].reshape((-1,) + sides[0].shape[2:])))
+        if nv > 1:
+            phi.append(_seam_angle(sides[3][grid[:, :-1]].reshape((-1,) + sides[3].shape[2:]),
+                                   sides[2][grid[:, 1:]].reshape((-1,) + sides[2].shape[2:])))
+        out[grid.ravel()] = 2.0 * max(float(p.max(initial=0.0)) for p in phi)
+    return out
+
+
+def _cells(model, cache) -> dict:
+    """The per-cell bounds of the model's patches (module docstring), computed once per model."""
+    if "nurbs_cells" in cache:
+        return cache["nurbs_cells"]
+    bs, widen = _bezier(model, cache)
+    P = len(bs)
+    r = int(max(2, min(16, math.isqrt(max(CELL_BUDGET // max(P, 1), 4)))))
+    out = {"r": r, "M": np.empty((P, r * r, 3)), "f": np.empty((P, r * r, 2)), "lo": np.empty((P, r * r, 3)),
+           "hi": np.empty((P, r * r, 3)), "N": np.empty((P, r * r, 5)), "eval": np.empty(P), "seam": np.empty(P)}
+    for g in bs.groups:
+        (m, n), C, ids = g.degree, g.control, g.ids
+        box = _grid_boxes(r, widen[ids])
+        size = np.stack([(box[..., 1] - box[..., 0]).ravel(), (box[..., 3] - box[..., 2]).ravel()], axis=1)
+        flat = {key: np.empty((len(ids) * r * r,) + out[key].shape[2:]) for key in ("M", "f", "lo", "hi", "N")}
+        sides = [np.empty((len(ids), r, 3 * max(m, n) - 1, 3)) for _ in range(4)]  # the cells along each side
+        cell = np.arange(len(ids) * r * r)
+        mag = np.column_stack([np.linalg.norm(C[..., :3], axis=-1).reshape(len(ids), -1).max(axis=1),
+                               C[..., 3].reshape(len(ids), -1).max(axis=1)])
+        for rows, Q in _sub_nets(C, box):
+            d = _cell_derivatives(Q, size[rows], mag[cell[rows] // (r * r)])
+            for key in ("M", "f", "lo", "hi"):
+                flat[key][rows] = d[key]
+            flat["N"][rows], rows4 = _cell_normals(_square(d["shifted"]), size[rows])
+            pa, a, b = cell[rows] // (r * r), cell[rows] // r % r, cell[rows] % r
+            for side, (sel, at) in enumerate(((a == 0, b), (a == r - 1, b), (b == 0, a), (b == r - 1, a))):
+                sides[side][pa[sel], at[sel]] = rows4[side][sel]
+        for key in flat:
+            out[key][ids] = flat[key].reshape(len(ids), r * r, -1)
+        out["seam"][ids] = _seams(bs, ids, sides, r)
+        # float64 evaluation of a vertex by the model (de Boor, then a division by w) [Higham2002, sec. 3.1]
+        w = C[..., 3].reshape(len(ids), -1)
+        size_p = np.linalg.norm(C[..., :3] / C[..., 3:], axis=-1).reshape(len(ids), -1).max(axis=1)
+        out["eval"][ids] = 8.0 * (m + 1) * (n + 1) * EPS * size_p * w.max(axis=1) / w.min(axis=1)
+    for key in ("M", "f", "lo", "hi", "N"):
+        out[key] = out[key].reshape(P, r, r, -1)
+    cache["nurbs_cells"] = out
+    return out
+
+
+def _ranges(n_from: int, n_to: int):
+    """For each of ``n_to`` equal intervals of [0, 1], the first and last of the ``n_from`` equal intervals whose
+    interior meets it: ``floor(j n_from / n_to)`` .. ``ceil((j + 1) n_from / n_to) - 1``."""
+    j = np.arange(n_to)
+    return (j * n_from) // n_to, -((-(j + 1) * n_from) // n_to) - 1
+
+
+def _range_max(X: np.ndarray, axis: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Along ``axis``, entry ``j`` of the result is the maximum of ``X`` over indices ``lo[j]..hi[j]``."""
+    out = np.take(X, lo, axis=axis)
+    for t in range(1, int((hi - lo).max()) + 1):
+        out = np.maximum(out, np.take(X, np.minimum(lo + t, hi), axis=axis))
+    return out
+
+
+def _to_level(X: np.ndarray, n_from: int, n_to: int) -> np.ndarray:
+    """``X (P, n_from, n_from, ...)`` per cell to ``(P, n_to, n_to, ...)``: maxima over the ranges that meet."""
+    lo, hi = _ranges(n_from, n_to)
+    return _range_max(_range_max(X, 1, lo, hi), 2, lo, hi)
+
+
+def _check_level(k) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise ValueError(f"k (samples per span) must be a positive integer, got {k!r}.")
+    return int(k)
+
+
+def chord_bounds(model, k: int, cache: dict | None = None) -> np.ndarray:
+    r"""Proven bounds ``(P, k, k)`` (world units) of the distance between each triangle of ``tessellate(model, k)``
+    and the surface point at the same ``(u, v)``, per Bezier patch (numbered as
+    :func:`splinevis.nurbs.lod.bezier.bezier_set`) and sub-square ``(i, j)`` of its local domain; the float64
+    evaluation of the vertices included, the float32 rounding on the GPU not.
+
+    Derivation. For a triangle ``T`` of the domain, ``L`` the linear interpolant of ``F`` at its vertices,
+    ``G = F - L`` is smooth and vanishes at the vertices, and ``D^2 G = D^2 F`` (``L`` is linear), so eq. (4) of
+    :mod:`splinevis.nurbs.lod.bounds` (Taylor's formula with integral remainder, [Kumar1997, sec. 4.1] after
+    [Filip1986]) applies to ``F`` itself: ``|F - L| <= (1/8)(du^2 M1 + 2 du dv M2 + dv^2 M3)`` with ``M`` bounds
+    of ``|F_uu|, |F_uv|, |F_vv|`` on ``T``'s box. Both triangles of a sub-square have ``du = dv = 1 / k`` (local
+    parameters); no interpolant enters, so one bound per sub-square holds for both and for every ``k``.
+
+    ``M`` of the rational ``F = A / w`` on a cell: with ``c`` the centre of the cell's control-point box,
+    ``E = F - c`` and ``A_c = A - c w = w E`` (the Bernstein net ``Q[:3] - c Q[3]``), the product rule gives
+    ``E_u = (A_c,u - w_u E) / w`` and ``E_uu = (A_c,uu - w_uu E - 2 w_u E_u) / w``,
+    ``E_uv = (A_c,uv - w_uv E - w_u E_v - w_v E_u) / w``; the derivatives of ``A_c`` and ``w`` are bounded by their
+    nets' differences (eq. (1) there, [Farin2002, ch. 5]), ``|E| <= R`` (the cell lies in the hull of its control
+    points, weights positive) and ``w >= min`` of its coefficients. A sub-square's ``M`` is the maximum over the
+    cells its interior meets (module docstring): ``(1/8k^2)(M1 + 2 M2 + M3)`` then bounds both of its triangles.
+    A polynomial patch has ``w`` constant: ``M`` is its net's second differences.
+
+    Rounding ([Higham2002, sec. 3.1], worst-case terms as in :mod:`splinevis.nurbs.lod.bounds`): the
+    subdivided coefficients are off by ``(m + n + 4) eps max |Q|``, added to each difference; the vertices'
+    parameters are off by a few ``eps`` (the cells are widened by that); the model evaluates the vertices to
+    ``8 (m + 1)(n + 1) eps max |P| max w / min w``, which is added.
+
+    >>> from splinevis.nurbs.exact import cylinder
+    >>> b = chord_bounds(cylinder(1.0), 4)  # 4 quarter arcs, 16 segments: 1 - cos(pi / 16) = 0.019 if equal
+    >>> b.shape, round(float(b.max()), 4)  # measured 0.0209 (tessellate.chord_deviation): 2.5x
+    ((4, 4, 4), 0.0519)
+    """
+    k = _check_level(k)
+    cache = {} if cache is None else cache
+    key = ("nurbs_chord", k)
+    if key not in cache:
+        cells = _cells(model, cache)
+        r, M = cells["r"], cells["M"]
+        Mk = _to_level(M, r, k)
+        # the vertices' parameters may lie a widening outside the sub-square: extents 1 / k + 2 delta
+        _, widen = _bezier(model, cache)
+        grow = (1.0 + 2.0 * k * widen.max(axis=1)) ** 2
+        chord = (Mk[..., 0] + 2.0 * Mk[..., 1] + Mk[..., 2]) / (8.0 * k * k) * grow[:, None, None]
+        cache[key] = chord + cells["eval"][:, None, None]
+    return cache[key]
+
+
+def normal_bounds(model, k: int, cache: dict | None = None) -> np.ndarray:
+    r"""Proven bounds ``(P, k, k)`` (radians) of the angle between the normal ``tessellate(model, k)`` shades with
+    and the exact normal at the same ``(u, v)``, per Bezier patch and sub-square (as :func:`chord_bounds`); the
+    float32 rounding of the normals not included; ``inf`` where none of the bounds below holds.
+
+    The mesh shades with a normalized convex combination of the exact unit normals at the triangle's vertices
+    (the rasterizer's interpolation; barycentric in the triangle, which is the interpolation in ``(u, v)``).
+    Three proven bounds, the smallest taken per sub-square; ``n = G / |G|`` with ``G = w^3 S_u x S_v`` the
+    pseudo-Gauss map, a positive combination of its Bernstein coefficients on each (sub-)patch [Kumar1997,
+    sec. 3] (:func:`splinevis.nurbs.lod.gauss.pseudo_gauss_net`):
+
+    * **cone** (computed in decreasing order of the other two bounds until the rest cannot raise the maximum,
+      for at most :data:`CONE_BUDGET` sub-squares): a convex cone of half-angle ``theta < 90`` degrees holding
+      the coefficients of the sub-patch's ``G`` (:func:`splinevis.nurbs.lod.gauss.normal_cone`) holds every
+      normal of the sub-patch; where ``G = 0`` (a pole) the normal is a limit of those, in the closed cone. The
+      vertex normals are in it, so is their positive combination (the cone is convex without 0), and so is the
+      exact normal at ``(u, v)``: two unit vectors of the cone are at most ``2 theta`` apart. This holds at poles,
+      where ``G`` vanishes along a side but its other coefficients (zero ones are ignored) still span a cone.
+    * **first order**: ``|dn| <= |dG| / |G|``; on a cell whose net of ``G`` has a cone with axis ``a``,
+      ``|G| >= g := min_kl G_kl . a`` and ``|G_u| <= (deg) max |Delta_u G_kl|`` (inf when ``g <= 0``: a pole, a
+      fold). The angle between ``n(p)`` and a vertex normal is at most the length of the path of ``n`` along the
+      segment (in the triangle), ``rho = (N_u + N_v) / k`` (``N`` the maxima of ``|n_u|, |n_v|`` over the cells
+      the sub-square meets); the cap of radius ``rho < 90`` degrees around ``n(p)`` is convex: ``rho``.
+    * **second order**: the interpolated vector ``sum l_i n(p_i)`` differs from ``n(p)`` by at most
+      ``e = (1/8k^2)(N_uu + 2 N_uv + N_vv)`` (eq. (4) of :mod:`splinevis.nurbs.lod.bounds` applied to the vector
+      function ``n``, whose interpolant is that sum), with, from ``G = |G| n`` differentiated twice,
+      ``|n_uu| <= (2 |G_uu| + 3 |G_u| |n_u|) / g``, ``|n_uv| <= (2 |G_uv| + 3 |G_u| |n_v|) / g`` (likewise
+      ``n_vv``); a vector within ``e < 1`` of a unit vector is within ``arcsin e`` of it in angle.
+
+    Seams: the tessellation shares the vertices of a surface's patches, and a vertex on a knot line carries
+    the normal of one side only (the model's evaluation there); where the surface is not G1 across the knot
+    line (a C0 crease) the other side's triangles shade with it. Per pair of adjacent patches the one-sided
+    normals along the common side are the side rows ``a(t), b(t)`` of their ``G`` nets: ``a x b = 0`` and
+    ``a . b >= 0`` (their Bernstein coefficients, to ``1e-12`` relative: rounding) means the same normals;
+    else ``sin phi <= max |(a x b)_l| / (min a_l . alpha  min b_l . beta)`` (``alpha, beta`` their cone axes;
+    inf when a minimum is not positive). A vertex's normal is then within ``2 Phi`` (``Phi`` the surface's
+    largest ``phi``; two seams meet at a corner vertex) of the sub-patch's own, which the bounds add (cone:
+    ``2 theta + 2 Phi`` while ``theta + 2 Phi < 90`` degrees; first order ``rho + 2 Phi``; second order ``e``
+    plus the chord ``2 Phi``). A C0 crease thus makes the surface's normal bound infinite, as it is (the mesh
+    smears the crease's shading over a row of triangles).
+
+    The cones use the sub-patches widened by the parameters' rounding (:func:`chord_bounds`); the float64
+    rounding of the nets (relative, ~1e-15) is far below the float32 term that :func:`mesh_normal_error_deg`
+    adds (8 u = 4.8e-7 radians).
+
+    >>> from splinevis.nurbs.exact import sphere
+    >>> b = normal_bounds(sphere(), 8)  # the poles included (cones of the sub-patches)
+    >>> b.shape, round(float(np.degrees(b.max())), 2)
+    ((8, 8, 8), 13.25)
+    """
+    k = _check_level(k)
+    cache = {} if cache is None else cache
+    key = ("nurbs_normal", k)
+    if key not in cache:
+        cells = _cells(model, cache)
+        r = cells["r"]
+        Nk = _to_level(cells["N"], r, k)
+        seam = cells["seam"][:, None, None]  # twice the largest seam angle of the patch's surface
+        rho = (Nk[..., 0] + Nk[..., 1]) / k
+        bound = np.where(rho + seam < 0.5 * math.pi, rho + seam, np.inf)
+        e = (Nk[..., 2] + 2.0 * Nk[..., 3] + Nk[..., 4]) / (8.0 * k * k) + seam  # |interpolated - n(p)|
+        with np.errstate(invalid="ignore"):
+            bound = np.minimum(bound, np.where(e < 1.0, np.arcsin(np.minimum(e, 1.0)), np.inf))
+        bs, widen = _bezier(model, cache)
+        # cones in decreasing order of the other bounds, until the rest cannot raise the maximum
+        flat, order = bound.ravel().copy(), np.argsort(-bound, axis=None, kind="stable")
+        pos, block = 0, 1024
+        while pos < min(order.size, CONE_BUDGET) and (pos == 0 or flat[order[pos]] > flat[order[:pos]].max()):
+            sel = order[pos:pos + min(block, CONE_BUDGET - pos)]
+            mask = np.zeros(bound.shape, dtype=bool)
+            mask.ravel()[sel] = True
+            half = _cone_halves(bs, widen, k, mask).ravel()[sel]
+            sm = seam.ravel()[np.unravel_index(sel, bound.shape)[0]]
+            flat[sel] = np.minimum(flat[sel], np.where(half + sm < 0.5 * math.pi, 2.0 * half + sm, np.inf))
+            pos, block = pos + sel.size, 2 * block
+        bound = flat.reshape(bound.shape)
+        cache[key] = bound
+    return cache[key]
+
+
+def _cone_halves(bs, widen, k, select) -> np.ndarray:
+    """``(P, k, k)``: the half-angle of the normal cone of each (widened) level-``k`` sub-patch where ``select``
+    (pi elsewhere and where there is none)."""
+    from .lod.bounds import subdivide
+    from .lod.gauss import normal_cone, pseudo_gauss_net
+
+    out = np.full(select.shape, math.pi)
+    for g in bs.groups:
+        p, i, j = np.nonzero(select[g.ids])
+        if not p.size:
+            continue
+        C = g.control
+        centre = 0.5 * (bs.bbox[g.ids, 0::2] + bs.bbox[g.ids, 1::2])  # G is translation invariant: no cancellation
+        C = np.concatenate([C[..., :3] - centre[:, None, None, :] * C[..., 3:], C[..., 3:]], axis=-1)
+        box = _grid_boxes(k, widen[g.ids])[p, i, j]
+        half = np.empty(p.size)
+        for a in range(0, p.size, _CHUNK):
+            rows = slice(a, a + _CHUNK)
+            G = pseudo_gauss_net(subdivide(C[p[rows]], box[rows]))
+            half[rows] = normal_cone(G.reshape(G.shape[0], -1, 3))[1]
+        out[g.ids[p], i, j] = half
+    return out
+
+
+def mesh_error_px(model, view, k, cache):
+    """(pixels, True): the proven screen-space error of ``tessellate(model, k)`` for ``view``: the chord bounds
+    (:func:`chord_bounds`) of the sub-squares meeting each cell, plus the float32 rounding of the vertices, over
+    the cell's box widened by that error (:meth:`splinevis.gl.screen_error.View.box_pixels`), plus the
+    sub-pixel snapping.
+
+    >>> from splinevis.gl.screen_error import View
+    >>> from splinevis.nurbs.exact import torus
+    >>> v = View((4.0, -5.0, 3.0), (0, 0, 0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(1, 20))
+    >>> cache = {}
+    >>> [round(mesh_error_px(torus(), v, k, cache)[0], 3) for k in (2, 8, 32)]  # falls as 1 / k^2
+    [355.853, 5.086, 0.296]
+    """
+    cells = _cells(model, cache)
+    r = cells["r"]
+    chord = chord_bounds(model, k, cache)
+    lo, hi = cells["lo"].reshape(-1, 3), cells["hi"].reshape(-1, 3)
+    err = _to_level(chord[..., None], k, r)[..., 0].reshape(-1) + float32_margin(lo, hi)
+    return float(view.box_pixels(lo - err[:, None], hi + err[:, None], err).max()) + SNAP_PX, True
+
+
+def mesh_normal_error_deg(model, view, k, cache):
+    """(degrees, True): the largest angle between the normal ``tessellate(model, k)`` shades with and the exact
+    normal (:func:`normal_bounds`, over the whole model), plus ``8 u`` radians for the float32 normals and
+    their interpolation (as the terrain's); inf where no bound holds.
+
+    >>> from splinevis.nurbs.exact import torus
+    >>> cache = {}
+    >>> [round(mesh_normal_error_deg(torus(), None, k, cache)[0], 2) for k in (2, 8, 32)]  # cones, then 1 / k^2
+    [63.72, 8.9, 0.55]
+    """
+    radians = float(normal_bounds(model, k, cache).max()) + 8.0 * U32
+    return (float(np.degrees(radians)) if radians < math.pi else math.inf), True
+
+
+def mesh_triangles(model, k, cache) -> int:
+    """Triangles of ``tessellate(model, k)``: two per sub-square, ``k x k`` per knot span (Bezier patch).
+
+    >>> from splinevis.nurbs.exact import torus
+    >>> mesh_triangles(torus(), 4, {})  # 16 spans
+    512
+    """
+    bs, _ = _bezier(model, cache)
+    return 2 * _check_level(k) ** 2 * len(bs)
+
+
+def nurbs_mesh_refuses(model, style) -> str | None:
+    """Why the mesh cannot draw ``model`` in ``style``: :func:`splinevis.gl.renderers.mesh_refuses`, or trim
+    loops (the tessellation does not cut them), or None.
+
+    >>> from splinevis.effects import Style
+    >>> from splinevis.nurbs.hard_cases import trimmed_plate
+    >>> nurbs_mesh_refuses(trimmed_plate(), Style())
+    'the tessellation ignores trim loops (1 trimmed surface)'
+    """
+    reason = mesh_refuses(model, style)
+    if reason:
+        return reason
+    trims = sum(t is not None for t in _model(model).trims)
+    if trims:
+        return f"the tessellation ignores trim loops ({trims} trimmed surface{'s' if trims > 1 else ''})"
+    return None
+
+
+def _mesh_build(plotter, model, style, k, cache, spline_options, add_options):
+    from .tessellate import tessellate
+
+    model = _model(model)
+    actor = add_mesh_actor(plotter, tessellate(model, k), style, spline_options)
+    if model.companion_meshes() and hasattr(plotter, "_add_companions"):  # a file's plain geometry, as add_spline
+        plotter._add_companions(model, style, spline_options.get("name"))
+    return actor
+
+
+#: The NURBS renderers (module docstring), declared on :data:`splinevis.nurbs.program.PROGRAM`.
+RENDERERS = (
+    Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, mesh_triangles, nurbs_mesh_refuses,
+             normal_error_deg=mesh_normal_error_deg),
+    Renderer("per_fragment", 10, exact=True),
+)
