@@ -76,8 +76,8 @@ import numpy as np
 from ..gl.renderers import Renderer, float32_margin
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["LEVELS", "SUBSQUARE_BUDGET", "position_bounds", "error_px", "normal_error_deg", "triangles", "RENDERERS",
-           "add_by_accuracy"]
+__all__ = ["LEVELS", "SUBSQUARE_BUDGET", "position_bounds", "error_px", "normal_error_deg", "triangles", "measure",
+           "RENDERERS", "add_by_accuracy"]
 
 #: Subdivision levels tried, in order of cost (the program takes levels up to 8; the triangle cap decides).
 LEVELS = (0, 1, 2, 3, 4, 5, 6, 7, 8)
@@ -359,6 +359,44 @@ def triangles(image, level, cache) -> int:
     return 2 * ((image.n - 1) << int(level)) ** 2
 
 
+def measure(image, view, level, cache, samples: int = 20_000, seed: int = 0):
+    """(pixels, degrees) measured on the level-``level`` mesh (the float64 twin's limit points and normals)
+    against the limit surface at ``samples`` random points of random triangles: the drawn point against the
+    surface point at the same parameter (their projections' distance in ``view``), and the normalized
+    interpolated vertex normal against the surface's normal there.
+
+    >>> from splinevis.geometry_image.image import image_uv, octahedral_to_sphere
+    >>> from splinevis.geometry_image.model import GeometryImage
+    >>> from splinevis.gl.screen_error import View
+    >>> gi = GeometryImage(octahedral_to_sphere(image_uv(9)), constrain=True)
+    >>> v = View((3, -4, 2), (0, 0, 0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 20))
+    >>> px, deg = measure(gi, v, 1, {})
+    >>> bool(0 < px <= error_px(gi, v, 1, {})[0]), bool(0 < deg <= normal_error_deg(gi, v, 1, {})[0])
+    (True, True)
+    """
+    from .subdivision import subdivide
+
+    rng = np.random.default_rng(seed)
+    N, m = image.n - 1, 1 << int(level)
+    M = N * m + 1
+    sub = subdivide(image.control, int(level))
+    p, nrm = sub.p.reshape(-1, 3), sub.n.reshape(-1, 3)
+    a, b = rng.integers(0, N * m, samples), rng.integers(0, N * m, samples)  # sub-square column (s), row (t)
+    v00 = b * M + a
+    upper = rng.random(samples) < 0.5  # grid_faces: (00, 01, 11) and (00, 11, 10), 01 = next column
+    v = np.where(upper[:, None], np.stack([v00, v00 + M + 1, v00 + M], 1), np.stack([v00, v00 + 1, v00 + M + 1], 1))
+    lam = rng.dirichlet((1.0, 1.0, 1.0), samples)
+    st = np.einsum("kj,kjd->kd", lam, np.stack([v % M, v // M], axis=-1) / m)
+    cells = np.stack([np.minimum(a // m, N - 1), np.minimum(b // m, N - 1)], 1)  # the triangle's own piece
+    drawn = np.einsum("kj,kjd->kd", lam, p[v])
+    shade = np.einsum("kj,kjd->kd", lam, nrm[v])
+    shade /= np.linalg.norm(shade, axis=1, keepdims=True)
+    exact = image.normals(st)
+    px = view.pixel_distance(drawn, image.evaluate(st, cells=cells))
+    deg = np.degrees(np.arctan2(np.linalg.norm(np.cross(shade, exact), axis=1), np.einsum("kd,kd->k", shade, exact)))
+    return (float(np.nanmax(px)) if np.isfinite(px).any() else 0.0), float(deg.max())
+
+
 def _build(plotter, image, style, level, cache, spline_options, add_options):
     """The program at ``level``; ``add_options`` may carry the program's ``backend``."""
     extra = dict(add_options or {})
@@ -402,5 +440,6 @@ def add_by_accuracy(plotter, image, style, options, max_error_px, max_normal_err
 
 #: The geometry image's renderers (module docstring), declared on :data:`splinevis.geometry_image.program.PROGRAM`.
 RENDERERS = (
-    Renderer("subdivision", 0, LEVELS, error_px, _build, triangles, exact=True, normal_error_deg=normal_error_deg),
+    Renderer("subdivision", 0, LEVELS, error_px, _build, triangles, exact=True, normal_error_deg=normal_error_deg,
+             measure=measure),
 )
