@@ -272,6 +272,7 @@ def _model_bounds(model, program, style):
     """World bounds the default camera is fitted to: ``model.bounds`` if the model has them, else those of
     what the program builds (its proxy, or its dataset)."""
     b = getattr(model, "bounds", None)
+    b = b() if callable(b) else b  # an attribute (pyvista, our splines) or a method (NurbsModel)
     if b is not None:
         return tuple(float(v) for v in b)
     built = program.make(model, style)

@@ -45,7 +45,7 @@ from .model import NurbsModel
 from .surface import NurbsSurface
 
 __all__ = ["CELL_BUDGET", "CONE_BUDGET", "chord_bounds", "normal_bounds", "mesh_error_px", "mesh_normal_error_deg",
-           "mesh_triangles", "nurbs_mesh_refuses", "RENDERERS"]
+           "mesh_measure", "mesh_triangles", "nurbs_mesh_refuses", "RENDERERS"]
 
 EPS = np.finfo(float).eps
 #: Most cells a model is cut into for the bounds (each patch ``r x r``, ``2 <= r <= 16``).
@@ -523,6 +523,46 @@ def nurbs_mesh_refuses(model, style) -> str | None:
     return None
 
 
+def mesh_measure(model, view, k, cache, samples: int = 20_000, seed: int = 0):
+    """(pixels, degrees) measured on the tessellation at ``k`` samples per span against the float64 surface:
+    at ``samples`` random points of random triangles, the drawn point against the surface point at the same
+    interpolated ``(u, v)`` (their projections' distance in ``view``) and the normalized interpolated vertex
+    normal against the surface's normal there.
+
+    >>> from splinevis.gl.screen_error import View
+    >>> from splinevis.nurbs.exact import torus
+    >>> v = View((0, -5, 3), (0, 0, 0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 20))
+    >>> px, deg = mesh_measure(torus(), v, 4, {})
+    >>> bool(0 < px <= mesh_error_px(torus(), v, 4, {})[0]), bool(0 < deg <= mesh_normal_error_deg(torus(), v, 4, {})[0])
+    (True, True)
+    """
+    from .tessellate import tessellate
+
+    model = _model(model)
+    mesh = tessellate(model, k)
+    tri = mesh.faces.reshape(-1, 4)[:, 1:]
+    rng = np.random.default_rng(seed)
+    t = tri[rng.integers(0, len(tri), samples)]
+    lam = rng.dirichlet(np.ones(3), samples)
+    P, UV, N, ID = (np.asarray(mesh.point_data[a], dtype=np.float64) if a != "points" else
+                    np.asarray(mesh.points, dtype=np.float64) for a in ("points", "uv", "Normals", "patch_id"))
+    drawn = np.einsum("nk,nkc->nc", lam, P[t])
+    uv = np.einsum("nk,nkc->nc", lam, UV[t])
+    shade = np.einsum("nk,nkc->nc", lam, N[t])
+    shade /= np.linalg.norm(shade, axis=1, keepdims=True)
+    exact, normal = np.empty((samples, 3)), np.empty((samples, 3))
+    surface = ID[t[:, 0]].astype(int)
+    for i, s in enumerate(model.surfaces):
+        sel = surface == i
+        exact[sel] = s.evaluate(uv[sel, 0], uv[sel, 1])
+        normal[sel] = s.normal(uv[sel, 0], uv[sel, 1])
+    px = view.pixel_distance(drawn, exact)
+    ok = np.isfinite(normal).all(axis=1) & (np.linalg.norm(normal, axis=1) > 0.5)  # no normal at a pole
+    deg = np.degrees(np.arctan2(np.linalg.norm(np.cross(shade[ok], normal[ok]), axis=1),
+                                np.einsum("nc,nc->n", shade[ok], normal[ok])))
+    return (float(np.nanmax(px)) if np.isfinite(px).any() else 0.0), (float(deg.max()) if ok.any() else 0.0)
+
+
 def _mesh_build(plotter, model, style, k, cache, spline_options, add_options):
     from .tessellate import tessellate
 
@@ -536,6 +576,6 @@ def _mesh_build(plotter, model, style, k, cache, spline_options, add_options):
 #: The NURBS renderers (module docstring), declared on :data:`splinevis.nurbs.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, mesh_triangles, nurbs_mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
     Renderer("per_fragment", 10, exact=True),
 )
