@@ -451,13 +451,13 @@ class Plotter(pv.Plotter):
         return self.add_spline(model, style, program_options={"level": level, "displacement": displacement,
                                                               "backend": backend}, **options)
 
-    def add_walkthrough(self, model, pixel_error: float = 1.0, *, delta: float | None = None, levels: int = 4,
+    def add_walkthrough(self, model, max_error_px: float = 1.0, *, delta: float | None = None, levels: int = 4,
                         threaded: bool = False, progress: bool = False, **options):
-        """Levels of detail of a large NURBS model drawn within ``pixel_error`` pixels of the surface [Kumar1997]:
-        returns the :class:`~splinevis.nurbs.lod.pipeline.Walkthrough`, whose ``fly(camera_path)`` renders a
-        camera path and ``interact()`` opens the window. ``model``: a NurbsModel (or surface), whose levels are
-        built with bounds ``delta * 4**l`` (default ``delta``: a thousandth of the model's size), or a ``LodModel``
-        already built; ``options`` go to the Walkthrough (``dynamic``, ``closeup``, ``color``, ...).
+        """Levels of detail of a large NURBS model within ``max_error_px`` pixels of the surface, chosen per
+        super-surface every frame [Kumar1997]: returns the :class:`~splinevis.nurbs.lod.pipeline.Walkthrough`,
+        whose ``fly(camera_path)`` renders a path, ``interact()`` opens the window. ``model``: a NurbsModel (or
+        surface), levels built with bounds ``delta * 4**l`` (default ``delta``: a thousandth of the model's size),
+        or a ``LodModel``; ``options`` go to the Walkthrough (``dynamic``, ``closeup``, ``color``, ...).
 
         >>> from splinevis.nurbs.exact import torus
         >>> pl = Plotter(off_screen=True, window_size=(64, 48))
@@ -474,7 +474,7 @@ class Plotter(pv.Plotter):
         if not isinstance(model, LodModel):
             step = 1e-3 * bezier_set(model).size if delta is None else float(delta)
             model = build_lod(model, step, levels=levels, progress=progress)
-        return Walkthrough(model, self, threaded=threaded, pixel_error=pixel_error, **options)
+        return Walkthrough(model, self, threaded=threaded, pixel_error=max_error_px, **options)
 
     def show(self, *args, jupyter_backend=None, **kwargs):
         """PyVista's :meth:`~pyvista.Plotter.show`. In Jupyter our programs render on the server: the ``static``
