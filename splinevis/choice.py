@@ -1,5 +1,7 @@
 """Choice of renderer by accuracy: the cheapest way to draw a spline whose screen-space error stays below
-``max_error_px`` for the current camera (``Plotter.add_spline/add_terrain/add_isosurface(..., max_error_px=...)``).
+``max_error_px`` and whose shading normals stay within ``max_normal_error_deg`` of the spline's for the current
+camera (``Plotter.add_spline/add_terrain/add_isosurface/add_nurbs/add_geometry_image(..., max_error_px=...)``),
+made again when the camera moves (:func:`add_model_by_accuracy`).
 
 **The renderers are part of each family's contract.** A family lists on its program
 (``SplineProgram.renderers``, :class:`splinevis.gl.renderers.Renderer`) the ways its models can be drawn: a
@@ -8,20 +10,23 @@ an error function ``error_px(model, view, level, cache) -> (pixels, proven)``, h
 meshes, a triangle count and the styles or models it refuses; its error functions and builders live in its
 own folder (e.g. ``splinevis/terrain/renderers.py``). This module knows no family: :func:`choose` takes the
 renderers of ``program_for(model)`` (:func:`renderers_for`), walks them in cost order and takes the first
-(for a mesh the smallest ``k``) whose error is at most ``max_error_px`` and whose triangle count is within
-:data:`TRIANGLE_CAP`; if none meets the request, the exact renderer with the smallest error is chosen and
-the choice says that the request is not met. A program that declares no exact renderer gets its own (the
+(for a mesh the smallest ``k``) whose error is at most ``max_error_px`` (and normal error, ``error_px``'s
+twin ``normal_error_deg``, at most ``max_normal_error_deg``) and whose triangle count is within
+:data:`TRIANGLE_CAP`, the cheapest of those (below); if none meets the request, the exact renderer closest to
+it is chosen and the choice says that the request is not met. A program that declares no exact renderer gets its own (the
 program itself, named after its kind); one that declares no renderers at all is drawn by its own only, and
 the choice says so.
 
-**Cost ranks** come from the studies' measurements on this machine (Mesa llvmpipe, 2 cores):
-docs/results/terrain/pareto.md (800 x 600): a mesh of 2,097,152 triangles draws in 148 ms, the terrain ray
-cast in 135-242 ms; docs/results/volume/volume.md (400 x 300): marching-cubes meshes of 4,176-65,840
-triangles in 4-16 ms, the isosurface ray cast in 251-667 ms. Hence meshes rank below the ray cast (the
-families declare rank 0 and 10) and the triangle cap is the largest mesh measured cheaper than the ray
-cast; benchmarks/bench_choice.py times the choices beside the ray cast (docs/results/choice/choice.md: the
-2,097,152-triangle mesh 1.6x cheaper). A mesh-guided ray cast (a program option) is measured per family and
-ranked between (:mod:`splinevis.terrain.renderers`).
+**Cost.** Among the renderers whose error meets the request (for a mesh, its smallest such ``k``) the choice
+draws the one of least estimated frame time when each declares ``Renderer.cost``
+(:func:`splinevis.gl.renderers.estimated_ms`: nanoseconds per pixel of the model's screen rectangle, a
+family's measured constant for its ray cast, and a mesh's per-pixel and per-triangle constants), else the one of
+lowest ``rank``. The constants were measured on this machine (Mesa llvmpipe, 2 cores) by
+benchmarks/bench_choice.py (docs/results/choice/choice.md): there a terrain mesh of 131,072 triangles took
+as long as the terrain's ray cast in pyvista's default view (32 against 35 ms) and one of 2,097,152 six times
+as long, while the NURBS program took 787 ms against 12-32 ms for tessellations within 2-0.1 px; hence ranks
+alone (meshes first) were not enough. The triangle cap :data:`TRIANGLE_CAP` still bounds what is built. On a
+GPU the constants should be measured again.
 
 **Screen-space error** is the distance, in pixels on the screen, between a point the renderer shows and
 the point of the exact (float64) spline it stands for; world errors become pixels by
@@ -219,8 +224,11 @@ def choose(model, view: View, max_error_px: float | None, style=None, *, program
     >>> y, x = np.mgrid[0:17, 0:17] / 16.0
     >>> t = TerrainSpline.from_heights(0.3 * np.sin(4 * x) * np.cos(3 * y), "C1", spacing=(1 / 16, 1 / 16))
     >>> v = View((0.5, -1.5, 1.5), (0.5, 0.5, 0.0), (0, 0, 1), 30.0, width=320, height=240)
-    >>> [(c.renderer, c.level) for c in (choose(t, v, e) for e in (2.0, 0.2, 0.02))]
-    [('mesh', 1), ('mesh', 3), ('mesh', 12)]
+    >>> [(c.renderer, c.level) for c in (choose(t, v, e) for e in (2.0, 0.2, 0.02))]  # the least estimated time
+    [('mesh', 1), ('mesh', 3), ('raycast', None)]
+    >>> c = choose(t, v, 0.02)
+    >>> [(o.name, o.level, round(o.cost_ms, 1)) for o in c.options if o.meets]  # 73,728 triangles against the ray cast
+    [('mesh', 12, 8.4), ('raycast', None, 5.8), ('mesh_guided', None, 7.8)]
     >>> c = choose(t, v, 0.02, triangle_cap=50_000)  # k = 12 has 73,728 triangles
     >>> c.renderer, c.meets, [str(o) for o in c.options[-3:]]  # the exact renderers: the cheaper one
     ('raycast', True, ['mesh k=12: over the cap of 50,000 triangles', 'raycast 0.0177 px (estimate)', 'mesh_guided 0.0177 px (estimate)'])
@@ -251,20 +259,27 @@ def choose(model, view: View, max_error_px: float | None, style=None, *, program
             px, proven = (r.error_px or _own_error(program))(model, view, level, cache)
             deg, deg_proven = _normal_error(r, model, view, level, cache) if max_deg is not None else (None, False)
             meets = px <= max_error_px and (deg is None or deg <= max_deg)
+            cost = r.cost(model, view, level, cache) if meets and r.cost is not None else None
             options.append(Option(r.name, level, float(px), proven, tri, meets=meets,
-                                  normal_deg=None if deg is None else float(deg), normal_proven=bool(deg_proven)))
+                                  normal_deg=None if deg is None else float(deg), normal_proven=bool(deg_proven),
+                                  cost_ms=cost))
             if meets:
                 break
-        if chosen is None:
-            chosen = next((o for o in options if o.meets), None)
-    if chosen is None:  # an exact renderer: its error estimate over-states grazing rays (module docstring)
-        exact = {r.name for r in rows if r.exact}
+    meeting = [o for o in options if o.meets]  # each renderer's cheapest level meeting the request
+    if meeting:  # by estimated frame time where every one has it, else by rank
+        chosen = (min(meeting, key=lambda o: o.cost_ms) if all(o.cost_ms is not None for o in meeting)
+                  else meeting[0])
+    else:  # an exact renderer, the one closest to meeting the request (its error estimate over-states grazing
+        exact = {r.name for r in rows if r.exact}  # rays: module docstring)
         pool = [o for o in options if not o.reason]
         if not pool:
             raise ValueError(f"no renderer of program {program.name!r} may draw this: "
                              + "; ".join(str(o) for o in options) + ".")
-        chosen = min([o for o in pool if o.name in exact] or pool,
-                     key=lambda o: (o.error_px if max_error_px < math.inf else 0.0, o.normal_deg or 0.0))
+
+        def shortfall(o):
+            return max(o.error_px / max_error_px, (o.normal_deg or 0.0) / max_deg if max_deg else 0.0)
+
+        chosen = min([o for o in pool if o.name in exact] or pool, key=shortfall)
     return Choice(program.name, max_error_px, chosen, tuple(options), view, note, max_deg)
 
 

@@ -103,7 +103,8 @@ def test_plotter_takes_the_normal_request():
     pl = splinevis.Plotter(off_screen=True, window_size=(160, 120))
     actor = pl.add_terrain(_bump(), "C1", read_options={"spacing": (0.1, 0.1)}, max_normal_error_deg=15.0,
                            reflection_lines=8)
-    assert actor.choice.renderer == "mesh" and actor.choice.chosen.normal_deg <= 15.0
+    # the mesh that proves 15 degrees or the ray cast, whichever is estimated cheaper in this small window
+    assert actor.choice.meets and actor.choice.chosen.normal_deg <= 15.0
     img = pl.screenshot()
     assert img.std() > 10
     pl.close()

@@ -106,6 +106,19 @@ class GeometryImage:
         return int(self.control.shape[0])
 
     @property
+    def bounds(self) -> tuple:
+        """``(xmin, xmax, ymin, ymax, zmin, zmax)`` of the control points: the limit surface lies in their convex
+        hull (a B-spline surface in that of its control net; the padding only repeats control points).
+
+        >>> from splinevis.geometry_image.image import image_uv, octahedral_to_sphere
+        >>> [round(v, 6) for v in GeometryImage(octahedral_to_sphere(image_uv(5)), constrain=True).bounds]
+        [-1.0, 1.0, -0.707107, 0.707107, -0.707107, 0.707107]
+        """
+        c = self.control.reshape(-1, 3)
+        lo, hi = c.min(axis=0), c.max(axis=0)
+        return tuple(float(v) for pair in zip(lo, hi) for v in pair)
+
+    @property
     def cut_vertices(self) -> np.ndarray:
         """``(4, 2)`` image coordinates ``(s, t)`` of the cut vertices.
 

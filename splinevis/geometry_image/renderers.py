@@ -73,7 +73,7 @@ import math
 
 import numpy as np
 
-from ..gl.renderers import Renderer, float32_margin
+from ..gl.renderers import Renderer, float32_margin, mesh_cost
 from ..gl.screen_error import SNAP_PX
 
 __all__ = ["LEVELS", "SUBSQUARE_BUDGET", "position_bounds", "error_px", "normal_error_deg", "triangles", "measure",
@@ -441,5 +441,5 @@ def add_by_accuracy(plotter, image, style, options, max_error_px, max_normal_err
 #: The geometry image's renderers (module docstring), declared on :data:`splinevis.geometry_image.program.PROGRAM`.
 RENDERERS = (
     Renderer("subdivision", 0, LEVELS, error_px, _build, triangles, exact=True, normal_error_deg=normal_error_deg,
-             measure=measure),
+             measure=measure, cost=mesh_cost(triangles)),
 )

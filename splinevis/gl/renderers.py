@@ -24,7 +24,8 @@ import numpy as np
 from .error_bounds import U32
 from .screen_error import View
 
-__all__ = ["Renderer", "Option", "Choice", "MESH_LEVELS", "float32_margin", "mesh_refuses", "add_mesh_actor"]
+__all__ = ["Renderer", "Option", "Choice", "MESH_LEVELS", "float32_margin", "mesh_refuses", "add_mesh_actor",
+           "MESH_NS_PER_PIXEL", "MESH_NS_PER_TRIANGLE", "estimated_ms", "model_box", "raycast_cost", "mesh_cost"]
 
 #: Samples per cell (or cube) tried for sampled meshes, in order of cost.
 MESH_LEVELS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64)
@@ -69,6 +70,10 @@ class Renderer:
         spline on samples of what the renderer draws (the points it draws against the spline points they stand
         for, in pixels of ``view``; the normals it shades with against the spline's): what the benchmarks and
         tests compare with the declared bounds. None: not measured.
+    cost : callable, optional
+        ``cost(model, view, level, cache) -> milliseconds``: the estimated frame time on this machine
+        (:func:`estimated_ms`). Among the renderers meeting a request the choice draws the one of least
+        estimated time when every one of them declares it, else the one of lowest ``rank``.
 
     Examples
     --------
@@ -89,6 +94,7 @@ class Renderer:
     program_options: tuple = ()
     normal_error_deg: Callable | None = None
     measure: Callable | None = None
+    cost: Callable | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -106,7 +112,8 @@ class Option:
     """A renderer considered: its name, level (``k``; None for ray casts), screen-space error (pixels; inf
     when unknown), whether that error is proven, triangles (meshes), whether it meets the request and why not;
     when the request bounds the normals too, the normal error (degrees; 0 for exact normals, inf unknown) and
-    whether it is proven (``normal_deg`` None: not asked).
+    whether it is proven (``normal_deg`` None: not asked); for an option meeting the request, its estimated
+    frame time ``cost_ms`` (None: its renderer declares no cost).
 
     >>> str(Option("mesh", 2, 0.8, True, 1024, True))
     'mesh k=2 0.8 px (proven, 1,024 triangles)'
@@ -127,6 +134,7 @@ class Option:
     reason: str = ""
     normal_deg: float | None = None
     normal_proven: bool = False
+    cost_ms: float | None = None
 
     def __str__(self):
         label = self.name + ("" if self.level is None else f" k={self.level}")
@@ -221,6 +229,75 @@ class Choice:
         head += (f" <= {request}" if self.meets else f"; nothing meets {request}, drawing the exact renderer")
         others = [str(o) for o in self.options if o is not self.chosen]
         return head + ("; considered: " + ", ".join(others) if others else "") + (f"; {self.note}" if self.note else "")
+
+
+#: Frame-time model of a mesh on this machine (Mesa llvmpipe, 2 cores, 800 x 600, one light): nanoseconds per
+#: pixel of the screen rectangle around the model and per triangle. Fitted to benchmarks/bench_choice.py
+#: (docs/results/choice/): terrain meshes of 8,192 to 2,097,152 triangles took 9.2 to 208 ms in one run
+#: (95 ns a triangle, about 8 ms for the 275,000 pixels of the model's screen rectangle); geometry-image
+#: levels 81 ns a triangle, NURBS tessellations 140.
+MESH_NS_PER_PIXEL = 30.0
+MESH_NS_PER_TRIANGLE = 95.0
+
+
+def estimated_ms(view, lo, hi, *, ns_per_pixel: float, triangles: int = 0) -> float:
+    """Estimated frame time (ms) of a renderer drawing a model in the box ``lo..hi`` for ``view``:
+    ``ns_per_pixel`` times the pixels of the screen rectangle around the box
+    (:meth:`~splinevis.gl.screen_error.View.box_area_pixels`) plus :data:`MESH_NS_PER_TRIANGLE` a triangle. A
+    ray cast's ``ns_per_pixel`` is its family's (measured, in its renderers module), a mesh's
+    :data:`MESH_NS_PER_PIXEL`. Rough (within 2x of the benchmark's frames) but enough to tell a mesh of two
+    million triangles from a ray cast of a small view.
+
+    >>> v = View((0, 0, 10), (0, 0, 0), (0, 1, 0), 90.0, width=200, height=200)
+    >>> round(estimated_ms(v, [-1, -1, 0], [1, 1, 0], ns_per_pixel=MESH_NS_PER_PIXEL, triangles=100_000), 3)
+    9.512
+    """
+    return (ns_per_pixel * view.box_area_pixels(lo, hi) + MESH_NS_PER_TRIANGLE * triangles) * 1e-6
+
+
+def model_box(model, cache) -> tuple:
+    """``(lo, hi)`` of ``model.bounds`` (an attribute or a method), kept in ``cache``.
+
+    >>> import pyvista as pv
+    >>> [v.tolist() for v in model_box(pv.Box(), {})]
+    [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]
+    """
+    if "box" not in cache:
+        b = model.bounds
+        b = b() if callable(b) else b
+        cache["box"] = (np.array(b[0::2], dtype=np.float64), np.array(b[1::2], dtype=np.float64))
+    return cache["box"]
+
+
+def raycast_cost(ns_per_pixel: float):
+    """A ``Renderer.cost`` for a program costing ``ns_per_pixel`` per pixel of the model's screen rectangle.
+
+    >>> import pyvista as pv
+    >>> v = View((0, 0, 10), (0, 0, 0), (0, 1, 0), 90.0, width=200, height=200)
+    >>> round(raycast_cost(1000.0)(pv.Box(), v, None, {}), 6)  # the box's near face at depth 9: (200 / 9)^2 px
+    0.493827
+    """
+    def cost(model, view, level, cache):
+        lo, hi = model_box(model, cache)
+        return estimated_ms(view, lo, hi, ns_per_pixel=ns_per_pixel)
+
+    return cost
+
+
+def mesh_cost(triangles):
+    """A ``Renderer.cost`` for a mesh with ``triangles(model, level, cache)`` triangles
+    (:data:`MESH_NS_PER_PIXEL`, :data:`MESH_NS_PER_TRIANGLE`).
+
+    >>> import pyvista as pv
+    >>> v = View((0, 0, 10), (0, 0, 0), (0, 1, 0), 90.0, width=200, height=200)
+    >>> round(mesh_cost(lambda model, level, cache: 1000 * level)(pv.Box(), v, 10, {}), 4)  # 494 px, 10,000 tri
+    0.9648
+    """
+    def cost(model, view, level, cache):
+        lo, hi = model_box(model, cache)
+        return estimated_ms(view, lo, hi, ns_per_pixel=MESH_NS_PER_PIXEL, triangles=triangles(model, level, cache))
+
+    return cost
 
 
 def float32_margin(lo, hi) -> float:

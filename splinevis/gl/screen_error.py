@@ -134,6 +134,26 @@ class View:
             out.append(np.where(inside[:, None], xy, np.nan))
         return np.linalg.norm(out[0] - out[1], axis=1)
 
+    def box_area_pixels(self, lo, hi) -> float:
+        """Pixels of the window covered by the screen rectangle around the projection of the box ``lo..hi``:
+        an upper bound of the pixels the box's contents can cover (the whole window if the box reaches behind
+        the eye plane; 0 if it is outside the view).
+
+        >>> v = View((0, 0, 10), (0, 0, 0), (0, 1, 0), 90.0, width=200, height=200)
+        >>> round(v.box_area_pixels([-1, -1, 0], [1, 1, 0]), 6), v.box_area_pixels([-1, -1, 0], [1, 1, 11])
+        (400.0, 40000.0)
+        """
+        m = self.matrix()
+        lo, hi = np.asarray(lo, dtype=np.float64).reshape(3), np.asarray(hi, dtype=np.float64).reshape(3)
+        corners = np.array([[(hi if (c >> a) & 1 else lo)[a] for a in range(3)] for c in range(8)])
+        h = corners @ m[:, :3].T + m[:, 3]
+        if (h[:, 3] <= 0).any():
+            return float(self.width * self.height)
+        ndc = np.clip(h[:, :2] / h[:, 3:4], -1.0, 1.0)
+        w = (ndc[:, 0].max() - ndc[:, 0].min()) * 0.5 * self.width
+        t = (ndc[:, 1].max() - ndc[:, 1].min()) * 0.5 * self.height
+        return float(w * t)
+
     def point_pixels(self, points, err) -> np.ndarray:
         """Pixels a world displacement of length ``err`` at ``points`` (n, 3) can move their projection by
         (module docstring); inf for visible points within ``err`` of the eye plane, 0 behind the eye.

@@ -39,12 +39,13 @@ import math
 import numpy as np
 
 from ..gl.error_bounds import U32
-from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
+from ..gl.renderers import (MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_cost, mesh_refuses,
+                             raycast_cost)
 from ..gl.screen_error import SNAP_PX
 from .model import NurbsModel
 from .surface import NurbsSurface
 
-__all__ = ["CELL_BUDGET", "CONE_BUDGET", "chord_bounds", "normal_bounds", "mesh_error_px", "mesh_normal_error_deg",
+__all__ = ["PER_FRAGMENT_NS_PER_PIXEL", "CELL_BUDGET", "CONE_BUDGET", "chord_bounds", "normal_bounds", "mesh_error_px", "mesh_normal_error_deg",
            "mesh_measure", "mesh_triangles", "nurbs_mesh_refuses", "RENDERERS"]
 
 EPS = np.finfo(float).eps
@@ -573,9 +574,19 @@ def _mesh_build(plotter, model, style, k, cache, spline_options, add_options):
     return actor
 
 
+def _on_model(cost):
+    """A cost function of a NurbsModel applied to what the program takes (a surface, a list)."""
+    return lambda model, view, level, cache: cost(_model(model), view, level, cache)
+
+
+#: The per-fragment program's frame time per pixel of the model's screen rectangle, ns (Newell's teapot at
+#: 800 x 600, pyvista's default view: 786.7 ms for 271,200 pixels, benchmarks/bench_choice.py).
+PER_FRAGMENT_NS_PER_PIXEL = 2900.0
+
+
 #: The NURBS renderers (module docstring), declared on :data:`splinevis.nurbs.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, mesh_triangles, nurbs_mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
-    Renderer("per_fragment", 10, exact=True),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure, cost=_on_model(mesh_cost(mesh_triangles))),
+    Renderer("per_fragment", 10, exact=True, cost=_on_model(raycast_cost(PER_FRAGMENT_NS_PER_PIXEL))),
 )

@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
+from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_cost, mesh_refuses, raycast_cost
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "third_derivative_bounds", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
+__all__ = ["RAYCAST_NS_PER_PIXEL", "mesh_error_px", "third_derivative_bounds", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
 
 
 def _boxes_and_hessian(terrain, cache):
@@ -191,10 +191,17 @@ def _mesh_build(plotter, terrain, style, k, cache, spline_options, add_options):
     return add_mesh_actor(plotter, sampled_mesh(terrain, k), style, spline_options)
 
 
+#: The box ray cast's frame time per pixel of the terrain's screen rectangle, ns (Franke 33 x 33 C1 at 800 x 600
+#: in pyvista's default view: 34.9 ms for 274,600 pixels, benchmarks/bench_choice.py); the mesh-guided one
+#: took 1.36 times the box's on the profile scene (docs/results/profile/).
+RAYCAST_NS_PER_PIXEL = 127.0
+
+
 #: The terrain's renderers (module docstring), declared on :data:`splinevis.terrain.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS, mesh_error_px, _mesh_build, _mesh_triangles, mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
-    Renderer("mesh_guided", 15, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1}),
-    Renderer("raycast", 10, exact=True),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure, cost=mesh_cost(_mesh_triangles)),
+    Renderer("mesh_guided", 15, exact=True, program_options={"proxy": "mesh", "mesh_samples": 1},
+             cost=raycast_cost(1.36 * RAYCAST_NS_PER_PIXEL)),
+    Renderer("raycast", 10, exact=True, cost=raycast_cost(RAYCAST_NS_PER_PIXEL)),
 )

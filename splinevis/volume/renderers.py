@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_refuses
+from ..gl.renderers import MESH_LEVELS, Renderer, add_mesh_actor, float32_margin, mesh_cost, mesh_refuses, raycast_cost
 from ..gl.screen_error import SNAP_PX
 
-__all__ = ["mesh_error_px", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
+__all__ = ["RAYCAST_NS_PER_PIXEL", "mesh_error_px", "mesh_normal_error_deg", "mesh_measure", "RENDERERS"]
 
 
 def _mesh1(surface, cache):
@@ -175,9 +175,14 @@ def _mesh_refuses(surface, style):
     return mesh_refuses(surface, style)
 
 
+#: The isosurface ray cast's frame time per pixel of the volume's screen rectangle, ns (Marschner-Lobb 41^3,
+#: quadratic, 800 x 600, pyvista's default view: 123.8 ms for 285,100 pixels, benchmarks/bench_choice.py).
+RAYCAST_NS_PER_PIXEL = 434.0
+
+
 #: The isosurface's renderers (module docstring), declared on :data:`splinevis.volume.program.PROGRAM`.
 RENDERERS = (
     Renderer("mesh", 0, MESH_LEVELS[:8], mesh_error_px, _mesh_build, _mesh_triangles, _mesh_refuses,
-             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure),
-    Renderer("raycast", 10, exact=True),
+             normal_error_deg=mesh_normal_error_deg, measure=mesh_measure, cost=mesh_cost(_mesh_triangles)),
+    Renderer("raycast", 10, exact=True, cost=raycast_cost(RAYCAST_NS_PER_PIXEL)),
 )
