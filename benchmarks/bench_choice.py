@@ -46,6 +46,23 @@ def _isosurface():
     return "isosurface: Marschner-Lobb 41^3, quadratic", model
 
 
+def _blob_isosurface():
+    from datasets_synthetic.volumes import blob
+    from splinevis.programs import get
+
+    field = blob()
+    grid = field.sample(41)
+    model = get("isosurface").model_from(grid.values, field.isovalue, "quadratic", order="zyx",
+                                         spacing=tuple(grid.spacing), origin=tuple(grid.origin))
+    return "isosurface: smooth blob 41^3, quadratic", model
+
+
+def _torus():
+    from splinevis.nurbs.exact import torus
+
+    return "NURBS: rational torus (exact, no degenerate point)", torus()
+
+
 def _nurbs():
     from datasets_synthetic.teapot import newell_teapot
 
@@ -64,7 +81,8 @@ def _geometry_image():
     return "geometry image: star blob, 33 x 33", model
 
 
-FAMILIES = {"terrain": _terrain, "isosurface": _isosurface, "nurbs": _nurbs, "geometry_image": _geometry_image}
+FAMILIES = {"terrain": _terrain, "isosurface": _isosurface, "isosurface_blob": _blob_isosurface, "nurbs": _nurbs,
+            "nurbs_torus": _torus, "geometry_image": _geometry_image}
 
 
 def _plotter():
@@ -117,7 +135,8 @@ def bench_family(family: str, repeats: int = 5) -> dict:
             rows.append({"max_error_px": px, "max_normal_error_deg": deg, "renderer": c.renderer, "level": c.level,
                          "triangles": c.chosen.triangles, "error_px": c.error_px, "proven": c.chosen.proven,
                          "normal_deg": c.chosen.normal_deg, "normal_proven": c.chosen.normal_proven,
-                         "measured_px": measured[key][0], "measured_deg": measured[key][1], "meets": c.meets})
+                         "measured_px": measured[key][0], "measured_deg": measured[key][1], "meets": c.meets,
+                         "estimated_ms": c.chosen.cost_ms})
     exact = next((r for r in rows_r if r.exact and r.build is None and not r.program_options), None)
     # the program as add_spline draws it by default: timed once, as the baseline (the always-exact program
     # where the family has one; the geometry image's default level otherwise)
@@ -184,46 +203,59 @@ def choice_markdown(results: list) -> str:
                   f"{res['exact_frame_min_ms']:.1f} ms fastest, "
                   f"{res['exact_frame_median_ms']:.1f} ms median, {res['repeats']} rounds.", "",
                   "| max_error_px | max normal deg | chosen | level | triangles | error px | proven | measured px "
-                  "| normal deg | proven | measured deg | meets | frame ms | baseline / chosen |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| normal deg | proven | measured deg | meets | estimated ms | frame ms | baseline / chosen |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in res["rows"]:
             tri = f"{r['triangles']:,}" if r["triangles"] else "-"
             lines.append(
                 f"| {r['max_error_px']:g} | {_fmt(r['max_normal_error_deg'], 'g')} | {r['renderer']} | "
                 f"{_fmt(r['level'])} | {tri} | {_fmt(r['error_px'])} | {r['proven']} | {_fmt(r['measured_px'])} | "
                 f"{_fmt(r['normal_deg'])} | {r['normal_proven'] if r['normal_deg'] else '-'} | "
-                f"{_fmt(r['measured_deg'])} | {r['meets']} | {r['frame_min_ms']:.1f} | {r['exact_over_chosen']:.2f} |")
+                f"{_fmt(r['measured_deg'])} | {r['meets']} | {_fmt(r['estimated_ms'], '.1f')} | "
+                f"{r['frame_min_ms']:.1f} | {r['exact_over_chosen']:.2f} |")
         lines.append("")
     return "\n".join(lines)
 
 
 def choice_figure(results: list, path) -> None:
-    """Error (proven or estimated, pixels) against frame time per family; the chosen options marked."""
+    """Error against frame time per family: each option chosen for some request (filled: its declared error,
+    proven or estimated; open: measured against the float64 spline), the baseline's frame (dashed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(results), figsize=(4.2 * len(results), 3.8), squeeze=False)
-    for ax, res in zip(axes[0], results):
+    cols = min(3, len(results))
+    rows_n = -(-len(results) // cols)
+    fig, axes = plt.subplots(rows_n, cols, figsize=(4.6 * cols, 3.9 * rows_n), squeeze=False)
+    for ax in axes.ravel()[len(results):]:
+        ax.axis("off")
+    for ax, res in zip(axes.ravel(), results):
         seen = {}
         for r in res["rows"]:
-            seen[(r["renderer"], r["level"])] = (r["frame_min_ms"], r["error_px"], r["renderer"])
-        for name in sorted({v[2] for v in seen.values()}):
-            pts = sorted(v[:2] for v in seen.values() if v[2] == name)
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=name)
+            seen[(r["renderer"], r["level"])] = (r["frame_min_ms"], r["error_px"], r["measured_px"])
+        for i, name in enumerate(sorted({k[0] for k in seen})):
+            pts = sorted(v for k, v in seen.items() if k[0] == name)
+            colour = f"C{i}"
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colour, label=f"{name} (declared)")
+            meas = [p for p in pts if p[2]]
+            if meas:
+                ax.plot([p[0] for p in meas], [p[2] for p in meas], "o", mfc="none", color=colour,
+                        label=f"{name} (measured)")
         for (name, level), (t, e, _) in seen.items():
-            ax.annotate("" if level is None else f"{level}", (t, e), textcoords="offset points", xytext=(4, 3),
-                        fontsize=7)
-        ax.axvline(res["exact_frame_min_ms"], color="k", ls="--", lw=0.8, label="exact program")
+            if level is not None:
+                ax.annotate(f"{level}", (t, e), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        ax.axvline(res["exact_frame_min_ms"], color="k", ls="--", lw=0.8, label=f"baseline: {res['baseline']}")
         for px in PIXELS:
             ax.axhline(px, color="0.85", lw=0.6, zorder=0)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("frame time, ms (fastest)")
-        ax.set_ylabel("screen-space error bound, px")
+        ax.set_xlabel("frame time, ms (fastest of the rounds)")
+        ax.set_ylabel("screen-space error, px")
         ax.set_title(res["scene"], fontsize=9)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6.5)
+    fig.suptitle("Choice by accuracy: the options chosen for max_error_px 2 .. 0.1 (grey lines) and normal requests; "
+                 "level labels = samples per span / cell or subdivision level", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -234,9 +266,15 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--families", default=",".join(FAMILIES))
     ap.add_argument("--out", default="out/bench")
+    ap.add_argument("--figure-only", action="store_true", help="redraw choice.md and choice.png from choice.json")
     args = ap.parse_args(argv)
-    results = [bench_family(f, args.repeats) for f in args.families.split(",")]
     out = Path(args.out)
+    if args.figure_only:
+        results = json.loads((out / "choice.json").read_text())
+        (out / "choice.md").write_text(choice_markdown(results))
+        choice_figure(results, out / "choice.png")
+        return
+    results = [bench_family(f, args.repeats) for f in args.families.split(",")]
     out.mkdir(parents=True, exist_ok=True)
     (out / "choice.json").write_text(json.dumps(results, indent=1))
     (out / "choice.md").write_text(choice_markdown(results))

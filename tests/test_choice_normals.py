@@ -147,3 +147,14 @@ def test_isosurface_mesh_normal_estimate_holds(field, iso, k):
     measured = float(np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", shading, exact), -1, 1))).max())
     bound, proven = mesh_normal_error_deg(surface, None, k, {})
     assert not proven and 0.0 < measured <= bound
+
+
+def test_walkthrough_takes_max_error_px_and_refuses_a_normal_request():
+    from splinevis.nurbs.exact import torus
+
+    pl = splinevis.Plotter(off_screen=True, window_size=(64, 48))
+    walk = pl.add_walkthrough(torus(), max_error_px=0.5, levels=2)
+    assert walk.pixel_error == 0.5
+    with pytest.raises(ValueError, match="bounds positions only"):
+        pl.add_walkthrough(torus(), levels=2, max_normal_error_deg=1.0)
+    pl.close()

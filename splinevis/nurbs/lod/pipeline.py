@@ -167,6 +167,8 @@ class Walkthrough:
         Super-surfaces that fill the screen drawn exactly by the per-fragment program (:mod:`.closeup`), their
         mesh kept as a backstop; its ``update`` runs on the renderer's thread each frame and its statistics join
         the frame log. Off by default: an exact close-up costs about a second a frame on this CPU renderer.
+    max_normal_error_deg : None
+        Not supported (ValueError saying what to use instead): the levels bound positions only.
 
     Examples
     --------
@@ -188,10 +190,17 @@ class Walkthrough:
     """
 
     def __init__(self, lod, plotter, threaded: bool = True, pixel_error=1.0, *, cull_frustum: bool = True,
-                 cull_back: bool = True, assemble=None, color: str = "tan", dynamic=False, closeup=None):
+                 cull_back: bool = True, assemble=None, color: str = "tan", dynamic=False, closeup=None,
+                 max_normal_error_deg=None):
         import pyvista as pv
 
         from .dynamic import Refiner
+
+        if max_normal_error_deg is not None:
+            raise ValueError("the level-of-detail walkthrough bounds positions only (its levels are chosen by their "
+                             "screen-space error [Kumar1997]); for normals within a bound draw the model with "
+                             "add_nurbs(model, max_normal_error_deg=...), which picks a tessellation whose normal "
+                             "error is proven, or the exact per-fragment program.")
 
         if dynamic is not False and dynamic is not True and not isinstance(dynamic, Refiner):
             raise TypeError(f"dynamic must be a bool or a Refiner, got {type(dynamic).__name__}.")
