@@ -158,3 +158,28 @@ def test_walkthrough_takes_max_error_px_and_refuses_a_normal_request():
     with pytest.raises(ValueError, match="bounds positions only"):
         pl.add_walkthrough(torus(), levels=2, max_normal_error_deg=1.0)
     pl.close()
+
+
+def test_the_choice_draws_the_meeting_renderer_of_least_estimated_time():
+    t = TerrainSpline.from_heights(_bump(), "C1", spacing=(0.1, 0.1))
+    for request in (2.0, 0.5, 0.05, 0.02):
+        c = choose(t, _view(), request)
+        meeting = [o for o in c.options if o.meets]
+        assert meeting and all(o.cost_ms is not None and o.cost_ms > 0 for o in meeting)
+        assert c.chosen.cost_ms == min(o.cost_ms for o in meeting)
+    # a coarse request: the mesh is cheaper; a fine one needs a mesh estimated dearer than the ray cast
+    assert choose(t, _view(), 2.0).renderer == "mesh" and choose(t, _view(), 0.02).renderer == "raycast"
+
+
+def test_when_nothing_meets_the_exact_renderer_closest_to_the_request_is_drawn():
+    from datasets_synthetic.closed_meshes import star_blob
+    from splinevis.geometry_image.program import model_from
+
+    gi = model_from(star_blob(level=3), 17)
+    view = View((0.0, -4.0, 2.0), (0.0, 0.0, 0.0), (0, 0, 1), 30.0, width=320, height=240, clipping_range=(0.5, 20))
+    c = choose(gi, view, 5.0, max_normal_error_deg=1e-3)  # no level proves a thousandth of a degree
+    assert not c.meets
+    pool = [o for o in c.options if not o.reason]
+    shortfall = [max(o.error_px / 5.0, o.normal_deg / 1e-3) for o in pool]
+    assert max(c.chosen.error_px / 5.0, c.chosen.normal_deg / 1e-3) == min(shortfall)
+    assert "nothing meets" in c.message
