@@ -46,3 +46,18 @@ def test_unchanged_camera_does_not_choose_again():
         pl.render()
     assert sum(actor.choices.values()) == 1
     pl.close()
+
+
+def test_a_geometry_image_takes_a_finer_level_when_the_camera_moves_in():
+    from datasets_synthetic.closed_meshes import star_blob
+
+    pl = splinevis.Plotter(off_screen=True, window_size=(200, 150))
+    actor = pl.add_geometry_image(star_blob(level=2), n=17, max_error_px=0.5, reflection_lines=8)
+    pl.screenshot()
+    first = actor.choice.level
+    pl.camera.zoom(4.0)
+    pl.render()
+    assert actor.choice.meets and actor.choice.level > first  # subdivision levels: finer when seen closer
+    assert actor.drawn.GetVisibility() and not actor.GetVisibility()
+    assert pl.screenshot().std() > 5
+    pl.close()
