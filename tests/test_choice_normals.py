@@ -149,14 +149,17 @@ def test_isosurface_mesh_normal_estimate_holds(field, iso, k):
     assert not proven and 0.0 < measured <= bound
 
 
-def test_walkthrough_takes_max_error_px_and_refuses_a_normal_request():
+def test_walkthrough_takes_max_error_px_and_a_normal_request():
     from splinevis.nurbs.exact import torus
 
     pl = splinevis.Plotter(off_screen=True, window_size=(64, 48))
     walk = pl.add_walkthrough(torus(), max_error_px=0.5, levels=2)
-    assert walk.pixel_error == 0.5
-    with pytest.raises(ValueError, match="bounds positions only"):
-        pl.add_walkthrough(torus(), levels=2, max_normal_error_deg=1.0)
+    assert walk.pixel_error == 0.5 and walk.max_normal_error_deg is None
+    walk = pl.add_walkthrough(torus(), levels=2, max_normal_error_deg=1.0)  # proven per level (LodModel.normal_bounds)
+    frames = walk.fly([[(0.0, -4.0, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]], progress=False)
+    assert walk.max_normal_error_deg == 1.0 and frames[0]["triangles"] > 0 and "normal_unmet" in frames[0]
+    with pytest.raises(ValueError, match="bound positions only"):  # dynamic tessellation: positions only
+        pl.add_walkthrough(torus(), levels=2, max_normal_error_deg=1.0, dynamic=True)
     pl.close()
 
 

@@ -30,6 +30,10 @@ triangle ``(a, b, c)`` whose side ``a b`` lies on the edge becomes ``(a, x_1, c)
 enclosing disc, so the old triangle's proven bound (``1/2 R^2 max |D^2_d F|`` [Waldron1998]) holds for every
 piece. Every vertex on a drawn edge is then used by both sides: no T-junction, no crack, at every combination
 of levels (tested by vertices and by pixels).
+
+Normals: every vertex carries the exact unit normal of one patch (:func:`vertex_normals`); the angle between the
+interpolated normals of each level and the surface's is bounded per super-surface and level
+(``LodModel.normal_bounds``, :mod:`splinevis.nurbs.normal_bounds`, the seams and fans included).
 """
 
 from __future__ import annotations
@@ -78,6 +82,10 @@ class LodModel:
         The model's diagonal.
     vertices : (V, 3) array
         Every shared vertex (corners and edge chains at the finest level) then every patch-interior vertex.
+    normal_bounds : (S, L) array
+        Radians: the proven angle between the normals each super-surface's level shades with (``normals``,
+        interpolated) and the surface's (:func:`splinevis.nurbs.normal_bounds.lod_normal_bounds`); inf where none
+        holds (a crease, a simplified level, trimmed patches).
 
     Examples
     --------
@@ -107,6 +115,7 @@ class LodModel:
     vertex_uv: np.ndarray = None  # (V, 2) its local parameters there
     trims: tuple = None  # per surface of the model: its trim loops (TrimCurve lists) or None
     status: np.ndarray = None  # (P,) per Bezier patch: 0 untrimmed or inside its trims, 1 clipped, -1 trimmed away
+    normal_bounds: np.ndarray = None  # (S, L) radians: the shading normals' proven angle to the surface's (inf: none)
 
     @property
     def levels(self) -> int:
@@ -227,10 +236,11 @@ def _patch_sides(edges, i, level, chains, births, edge_ids, corner_label):
     return side_chain, side_ids
 
 
-def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id, fixed=None, joins=None):
+def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id, fixed=None, joins=None, kept=None):
     """The tessellation ``tess`` of patch ``i`` in global ids: (new interior points, triangles, next free id).
     ``fixed``: a global id for some vertices (stitched trim vertices, :mod:`.stitch`), -1 elsewhere; where such a
-    vertex lies on a side, the pair (its id, the chain vertex's id) is appended to ``joins``."""
+    vertex lies on a side, the pair (its id, the chain vertex's id) is appended to ``joins``; ``kept``: a list the
+    local triangles kept (not degenerate at a pole) are appended to."""
     Pw = bs.control(i)
     uv = tess.uv
     gid = np.full(uv.shape[0], -1, dtype=np.int64) if fixed is None else np.array(fixed, dtype=np.int64)
@@ -255,8 +265,10 @@ def _patch_finish(bs, edges, i, tess, side_chain, side_ids, next_id, fixed=None,
     new_points = patch_points(Pw, uv[inner]) if inner.size else np.zeros((0, 3))
     tri = gid[tess.triangles]
     # a triangle with two corners on a pole's side has two vertices that are the one pole vertex: no area
-    tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])]
-    return new_points, tri, next_id + inner.size, uv[inner]
+    keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])
+    if kept is not None:
+        kept.append(tess.triangles[keep])
+    return new_points, tri[keep], next_id + inner.size, uv[inner]
 
 
 def _borders(edges, label, S):
@@ -308,14 +320,20 @@ def vertex_normals(bezier, patch, uv) -> np.ndarray:
     >>> (np.round(n, 5) + 0.0).tolist()[0], bool(abs(n[1] @ evaluate(bs, [0], [0.3], [0.6])[0] - 1) < 1e-12)
     ([0.0, 0.0, -1.0], True)
     """
+    return _vertex_normals(bezier, patch, uv)[0]
+
+
+def _vertex_normals(bezier, patch, uv):
+    """:func:`vertex_normals` and where the normal was taken inside (``(n,)`` bool: nudged)."""
     from .bezier import evaluate
 
     patch, uv = np.asarray(patch, dtype=np.int64), np.asarray(uv, dtype=np.float64).reshape(-1, 2)
     out = np.zeros((patch.size, 3))
-    if patch.size == 0:
-        return out
     todo = np.arange(patch.size)
+    nudged = np.zeros(patch.size, dtype=bool)
     for nudge in (0.0, 1e-6, 1e-4):
+        if todo.size == 0:
+            break
         q = uv[todo] + nudge * (0.5 - uv[todo])
         _, Su, Sv = evaluate(bezier, patch[todo], q[:, 0], q[:, 1], derivatives=True)
         n = np.cross(Su, Sv)
@@ -323,10 +341,10 @@ def vertex_normals(bezier, patch, uv) -> np.ndarray:
         scale = np.linalg.norm(Su, axis=1) * np.linalg.norm(Sv, axis=1)
         ok = size > 1e-10 * np.maximum(scale, np.finfo(float).tiny)
         out[todo[ok]] = n[ok] / size[ok, None]
+        nudged[todo[ok]] = nudge > 0.0
         todo = todo[~ok]
-        if todo.size == 0:
-            break
-    return out
+    nudged[todo] = True
+    return out, nudged
 
 
 def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha: float = np.radians(30.0),
@@ -426,22 +444,25 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             if status[i] == 1:
                 tess[n] = clip_patch(bs.control(i), plan.local[i], side_chain, float(deltas[level] - delta_trim),
                                      tess[n], local_rings(stitch.rings[int(bs.parent[i])][0], bs.rect[i]))
-    raw, n, joins = [], 0, []
+    raw, n, joins, local = [], 0, [], {}  # local[s, level]: each triangle's patch, its vertices' local (u, v)
     for s in range(S):
         per_level = []
         for level in range(deltas.size):
-            tris = []
+            tris, kept = [], []
             for _ in drawn[s]:
                 i, _, side_chain, side_ids = jobs[n]
                 fixed = (fixed_ids(stitch, node_gid, bs.rect[i], int(bs.parent[i]), tess[n].uv)
                          if trimmed and status[i] == 1 else None)
                 new, tri, next_id, uv = _patch_finish(bs, edges, i, tess[n], side_chain, side_ids, next_id, fixed,
-                                                      joins)
+                                                      joins, kept)
+                kept[-1] = (np.full(len(tri), i), tess[n].uv[kept[-1]])
                 n += 1
                 all_points.append(new)
                 where.append((np.full(len(uv), i), uv))
                 tris.append(tri)
             per_level.append(np.concatenate(tris) if tris else np.zeros((0, 3), dtype=np.int64))
+            if kept and not (status[drawn[s]] == 1).any() and (simplify is None or level == 0):  # else unbounded
+                local[s, level] = tuple(np.concatenate(x) for x in zip(*kept))
         raw.append(per_level)
     vertices = np.concatenate(all_points)
     if joins:  # stitched vertices that are chain vertices of their own surface: one vertex, the chain's
@@ -451,7 +472,7 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
         raw = [[remap[t] for t in per_level] for per_level in raw]
     vertex_patch = np.concatenate([w[0] for w in where]).astype(np.int64)
     vertex_uv = np.concatenate([w[1] for w in where])
-    normals = vertex_normals(bs, vertex_patch, vertex_uv)
+    normals, nudged = _vertex_normals(bs, vertex_patch, vertex_uv)
     tolerance = deltas.copy()
     simplified = np.zeros((S, deltas.size))
     if simplify is not None:
@@ -464,6 +485,10 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
             per_level.append((tri, _fan_rows(tri, border[s], edge_ids, births, level)))
             counts[s, level] = tri.shape[0]
         meshes.append(tuple(per_level))
+    from ..normal_bounds import lod_normal_bounds
+
+    records = [(s, level, meshes[s][level][0], *local[s, level], meshes[s][level][1]) for s, level in local]
+    normal_bounds = lod_normal_bounds(bs, edges, corner_label, edge_ids, normals, nudged, records, counts.shape)
     boxes = np.empty((S, 6))
     for s in range(S):
         b = bs.bbox[np.asarray(supers.members[s])]
@@ -471,7 +496,7 @@ def build_lod(model, delta: float, *, levels: int = 4, ratio: float = 4.0, alpha
     return LodModel(bs, edges, supers, build_bvh(boxes), boxes, tolerance, counts, bs.size, vertices,
                     tuple(edge_ids), tuple(births), tuple(meshes), tuple(border), simplified, normals,
                     delta_trim=delta_trim, status=status, vertex_patch=vertex_patch, vertex_uv=vertex_uv,
-                    trims=tuple(model.trims) if trimmed else None)
+                    trims=tuple(model.trims) if trimmed else None, normal_bounds=normal_bounds)
 
 
 def _between(lod, eid, a, b, level):

@@ -167,8 +167,11 @@ class Walkthrough:
         Super-surfaces that fill the screen drawn exactly by the per-fragment program (:mod:`.closeup`), their
         mesh kept as a backstop; its ``update`` runs on the renderer's thread each frame and its statistics join
         the frame log. Off by default: an exact close-up costs about a second a frame on this CPU renderer.
-    max_normal_error_deg : None
-        Not supported (ValueError saying what to use instead): the levels bound positions only.
+    max_normal_error_deg : float or None
+        Largest angle in degrees between the normals drawn and the surface's: each super-surface is drawn no coarser
+        than its levels' proven normal bounds allow (``LodModel.normal_bounds``, :func:`.select.select_levels`; the
+        frames count the super-surfaces drawn finer for it, ``normal_limited``, and those no level meets,
+        ``normal_unmet``); not with ``dynamic`` (its finer tessellations bound positions only).
 
     Examples
     --------
@@ -196,12 +199,9 @@ class Walkthrough:
 
         from .dynamic import Refiner
 
-        if max_normal_error_deg is not None:
-            raise ValueError("the level-of-detail walkthrough bounds positions only (its levels are chosen by their "
-                             "screen-space error [Kumar1997]); for normals within a bound draw the model with "
-                             "add_nurbs(model, max_normal_error_deg=...), which picks a tessellation whose normal "
-                             "error is proven, or the exact per-fragment program.")
-
+        if max_normal_error_deg is not None and (dynamic is not False or getattr(lod, "normal_bounds", None) is None):
+            raise ValueError("max_normal_error_deg needs levels with proven normal bounds (build_lod's) and no dynamic "
+                             "tessellation (its finer tessellations bound positions only).")
         if dynamic is not False and dynamic is not True and not isinstance(dynamic, Refiner):
             raise TypeError(f"dynamic must be a bool or a Refiner, got {type(dynamic).__name__}.")
         if dynamic is not False and assemble is not None:
@@ -215,6 +215,7 @@ class Walkthrough:
         self.plotter = plotter
         self.threaded = bool(threaded)
         self.pixel_error = pixel_error
+        self.max_normal_error_deg = max_normal_error_deg
         self.cull_frustum = bool(cull_frustum)
         self.cull_back = bool(cull_back)
         self._assemble = assemble
@@ -248,7 +249,7 @@ class Walkthrough:
         extra = {} if self.refiner is None else {"finer_ratio": self.refiner.ratio,
                                                   "max_finer": self.refiner.max_steps}
         levels, stats = select_levels(self.lod, eye, M, H, self.pixel_error, self.cull_back,
-                                      cull_frustum=self.cull_frustum, **extra)
+                                      cull_frustum=self.cull_frustum, max_normal_deg=self.max_normal_error_deg, **extra)
         return frame, levels, stats, 1e3 * (time.perf_counter() - t0), eye
 
     def _build(self, selection, last, budget=None):
@@ -352,7 +353,9 @@ class Walkthrough:
         had not changed; the assembly includes the dynamic tessellation), ``upload_ms`` and ``render_ms``; of the
         dynamic tessellation (0 without): ``refined`` and ``refined_triangles`` (super-surfaces drawn finer than
         level 0 and their triangles), ``tessellate_ms`` (``T``'s time tessellating since the previous frame),
-        ``finer_pending`` (drawn coarser than asked, being made) and ``finer_capped`` (where a cap binds).
+        ``finer_pending`` (drawn coarser than asked, being made) and ``finer_capped`` (where a cap binds);
+        ``normal_limited`` and ``normal_unmet`` (super-surfaces drawn finer for ``max_normal_error_deg``, and met
+        by no level: :func:`.select.select_levels`).
         ``frames_dir``: write ``frame_0000.png`` ... there.
 
         Before the first frame the mesh for the first camera is built and drawn once (not timed), in both
@@ -413,7 +416,8 @@ class Walkthrough:
                             "upload_ms": 1e3 * (t2 - t1), "render_ms": 1e3 * (t3 - t2),
                             "refined": dyn["refined"], "refined_triangles": dyn["refined_triangles"],
                             "tessellate_ms": t_ms, "finer_pending": dyn["pending"],
-                            "finer_capped": dyn["capped"], **cu})
+                            "finer_capped": dyn["capped"], "normal_limited": int(record[5].get("normal_limited", 0)),
+                            "normal_unmet": int(record[5].get("normal_unmet", 0)), **cu})
         finally:
             self._halt()
         if self._error is not None:

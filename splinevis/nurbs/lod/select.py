@@ -28,6 +28,12 @@ how many finer steps it needs: the smallest ``j`` with ``tol_0 / finer_ratio**j 
 ``max_finer`` (``stats["finer_capped"]`` counts where the cap binds, the eye inside the box included), the
 tolerance the dynamic tessellation of :mod:`.dynamic` makes [Kumar1997, sec. 2.2, 4.4].
 
+**Normal request.** With ``max_normal_deg`` a super-surface is drawn at the coarsest level, no coarser than the
+screen-space error allows, whose proven normal bound (``lod.normal_bounds`` (S, L) radians,
+:func:`splinevis.nurbs.normal_bounds.lod_normal_bounds`, plus ``8 u`` for the float32 normals and their
+interpolation) is within it; ``stats["normal_limited"]`` counts those drawn finer for it, and
+``stats["normal_unmet"]`` those where even level 0 does not meet it (drawn at level 0).
+
 **The projection from the matrix.** The rows of ``M`` are ``r_i = sum_j P_ij v_j`` with ``v_j`` the
 orthonormal rows of ``V``'s rotation: ``|r_1[:3]| = P_11`` (symmetric frustum) and ``|r_3[:3]| = 1`` for a
 perspective (``w`` is the depth) or 0 for a parallel projection. Hence ``tan(fov_y / 2) = |r_3[:3]| /
@@ -40,6 +46,7 @@ import math
 
 import numpy as np
 
+from ...gl.error_bounds import U32
 from .bvh import back_facing, frustum_cull, frustum_planes
 
 __all__ = ["select_levels", "projection_scale"]
@@ -79,7 +86,7 @@ def _box_distance(boxes, eye):
 
 
 def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_back: bool = True, fov_y=None, *,
-                  cull_frustum: bool = True, finer_ratio: float = 4.0, max_finer: int = 4):
+                  cull_frustum: bool = True, finer_ratio: float = 4.0, max_finer: int = 4, max_normal_deg=None):
     """A level per super-surface for one view: ``(levels (S,) int, stats)``, ``-1`` where not drawn
     (module docstring) [Kumar1997, sec. 4.4].
 
@@ -104,6 +111,9 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         View-frustum culling (off: every super-surface is tested for back-facing and drawn otherwise).
     finer_ratio, max_finer : float, int
         Finer step ``j`` has the tolerance ``tol_0 / finer_ratio**j``, ``j <= max_finer`` (``stats["finer_steps"]``).
+    max_normal_deg : float or None
+        Largest angle in degrees between the shading normals and the surface's (module docstring); needs
+        ``lod.normal_bounds``.
 
     Returns
     -------
@@ -112,8 +122,8 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         ``visible``, ``culled_frustum``, ``culled_back``, ``needs_finer`` (drawn at level 0 although its
         projected error exceeds ``pixel_error``), ``finer_steps`` ((S,) int: the finer steps each of those needs,
         0 elsewhere), ``finer_capped`` (how many need more than ``max_finer``), ``per_level`` (drawn count per
-        level, finest first) and ``triangles`` (sum of ``lod.triangles`` of the chosen levels, before the
-        assembly's fans).
+        level, finest first), ``triangles`` (sum of ``lod.triangles`` of the chosen levels, before the
+        assembly's fans), ``normal_limited`` and ``normal_unmet`` (module docstring; 0 without a normal request).
 
     Examples
     --------
@@ -138,6 +148,17 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
     >>> levels, stats = select_levels(lod, [0, 0, 0], M, 200, pixel_error=0.01)
     >>> levels.tolist(), stats["needs_finer"], stats["finer_steps"].tolist()
     ([0, 1, -1], 1, [2, 0, 0])
+
+    Normal bounds of 1, 5 and 20 degrees per level: a request of 6 degrees draws the far one at level 1 where the
+    pixel error allowed 2; one of half a degree is met by no level: level 0, counted.
+
+    >>> lod.normal_bounds = np.radians([[1.0, 5.0, 20.0]] * 3)
+    >>> levels, stats = select_levels(lod, [0, 0, 0], M, 200, max_normal_deg=6.0)
+    >>> levels.tolist(), stats["normal_limited"], stats["normal_unmet"]
+    ([1, 1, -1], 1, 0)
+    >>> levels, stats = select_levels(lod, [0, 0, 0], M, 200, max_normal_deg=0.5)
+    >>> levels.tolist(), stats["normal_limited"], stats["normal_unmet"]
+    ([0, 0, -1], 2, 2)
     """
     S = int(np.asarray(lod.boxes).shape[0])
     boxes = np.asarray(lod.boxes, dtype=np.float64).reshape(S, 6)
@@ -150,6 +171,11 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
         raise ValueError(f"pixel_error must be a non-negative number of pixels or None, got {pixel_error!r}.")
     if not (float(finer_ratio) > 1.0 and math.isfinite(float(finer_ratio))) or int(max_finer) < 0:
         raise ValueError(f"finer_ratio must be > 1 and max_finer >= 0, got {finer_ratio!r}, {max_finer!r}.")
+    if max_normal_deg is not None:
+        if not float(max_normal_deg) > 0.0:
+            raise ValueError(f"max_normal_deg must be a positive angle in degrees or None, got {max_normal_deg!r}.")
+        if getattr(lod, "normal_bounds", None) is None:
+            raise ValueError("lod has no normal_bounds (build it with build_lod) for a max_normal_deg request.")
     if cull_frustum:
         ids = frustum_cull(lod.bvh, frustum_planes(view_proj))
     else:
@@ -187,11 +213,20 @@ def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_ba
                 finer_capped = int((j > int(max_finer)).sum())
                 finer[ids[short]] = np.minimum(j, int(max_finer)).astype(np.int64)
         levels[ids] = chosen
+    limited = unmet = 0
+    if max_normal_deg is not None and ids.size:  # the coarsest level <= chosen meeting the normal request
+        chosen = levels[ids]
+        meets = np.degrees(np.asarray(lod.normal_bounds)[ids] + 8.0 * U32) <= float(max_normal_deg)
+        meets &= np.arange(L)[None, :] <= chosen[:, None]
+        best = np.where(meets.any(axis=1), L - 1 - np.argmax(meets[:, ::-1], axis=1), 0)
+        limited, unmet = int((best < chosen).sum()), int((~meets.any(axis=1)).sum())
+        levels[ids] = best
     drawn = levels >= 0
     per_level = np.bincount(levels[drawn], minlength=L)
     tri = np.asarray(lod.triangles)
     triangles = int(tri[np.flatnonzero(drawn), levels[drawn]].sum()) if drawn.any() else 0
     stats = {"visible": int(drawn.sum()), "culled_frustum": culled_frustum, "culled_back": culled_back,
              "needs_finer": needs_finer, "finer_steps": finer, "finer_capped": finer_capped,
-             "per_level": per_level.tolist(), "triangles": triangles}
+             "per_level": per_level.tolist(), "triangles": triangles, "normal_limited": limited,
+             "normal_unmet": unmet}
     return levels, stats
