@@ -68,8 +68,10 @@ __all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_
 
 log = logging.getLogger("splinevis")
 
-#: Largest mesh (triangles) the choice builds: the largest mesh measured cheaper than the ray cast
-#: (docs/results/terrain/pareto.md: 1025 x 1025 vertices, 2,097,152 triangles, 148 ms vs 135-242 ms).
+#: Largest mesh (triangles) the choice builds: the largest mesh measured cheaper than the ray cast when the cap
+#: was set (docs/results/terrain/pareto.md: 1025 x 1025 vertices, 2,097,152 triangles, 148 ms against 135-242
+#: ms; since the ray cast walks in rounds, 182 against 55-76 ms: the estimated costs, not the cap, now keep
+#: such meshes from being drawn where the ray cast is cheaper).
 TRIANGLE_CAP = 2_097_152
 
 #: Keywords of ``add_spline`` that go to the program, not to the style.
