@@ -67,8 +67,9 @@ def mesh_error_px(surface, view, k, cache):
     lo, hi = c["boxes"]
     if len(lo) == 0:
         return SNAP_PX, False
-    h = np.asarray(surface.spline.spacing, dtype=np.float64) / k
-    delta = c["hessian"] * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)  # as sampled_mesh.distance_estimates
+    from .sampled_mesh import value_error_factor
+
+    delta = c["hessian"] * value_error_factor(surface.spline.spacing, k)
     g = c["gradient"]
     err = (delta / g if g > 0 else np.full(len(delta), np.inf)) + float32_margin(lo, hi)
     return float(view.box_pixels(lo, hi, err).max()) + SNAP_PX, False
@@ -99,12 +100,14 @@ def mesh_normal_error_deg(surface, view, k, cache):
     c = _bounds(surface, cache)
     if len(c["hessian"]) == 0:
         return 0.0, False
-    h = np.asarray(surface.spline.spacing, dtype=np.float64) / k
-    delta = c["hessian"] * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)
+    from .sampled_mesh import value_error_factor
+
+    delta = c["hessian"] * value_error_factor(surface.spline.spacing, k)
     g = c["gradient"]
     if not g > 0:
         return float("inf"), False
-    radians = float((c["hessian"] / g * (np.sqrt((h ** 2).sum()) + delta / g)).max())
+    diagonal = float(np.linalg.norm(np.asarray(surface.spline.spacing, dtype=np.float64))) / k  # D
+    radians = float((c["hessian"] / g * (diagonal + delta / g)).max())
     return float(np.degrees(min(radians, np.pi))), False
 
 

@@ -32,7 +32,7 @@ from ..bb import simplex as _bb
 from . import schemes as _schemes
 from .partition import NUM_TETS, _bary_mats
 
-__all__ = ["hessian_bounds", "distance_estimates", "gradient_floor", "sample_spline", "sampled_mesh",
+__all__ = ["hessian_bounds", "value_error_factor", "distance_estimates", "gradient_floor", "sample_spline", "sampled_mesh",
            "fine_points", "MAX_FINE_POINTS"]
 
 #: Largest fine grid (points) :func:`sample_spline` builds.
@@ -67,6 +67,18 @@ def hessian_bounds(spline, cubes, *, chunk: int = 8192) -> np.ndarray:
     return out
 
 
+def value_error_factor(spacing, k: int) -> float:
+    """``e_max^2 / 8 + D^2 / 2`` of the fine cells at ``k`` samples per cube (``e_max`` their longest side, ``D``
+    their diagonal): times a cube's Hessian bound ``M``, the proven value error ``delta`` on the mesh (edge
+    interpolation plus the triangle's chord, module docstring).
+
+    >>> value_error_factor((1.0, 1.0, 1.0), 2)  # 1/32 + 3/8
+    0.40625
+    """
+    h = np.asarray(spacing, dtype=np.float64) / int(k)
+    return float(h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)
+
+
 def distance_estimates(spline, cubes, k: int, gradient_min: float) -> np.ndarray:
     """(n,) estimated distance (world) from the ``k``-sampled mesh to the isosurface in each cube: delta / g
     with delta = M (e_max^2 / 8 + D^2 / 2) (proven value error on the mesh) and g = ``gradient_min`` (module
@@ -78,8 +90,7 @@ def distance_estimates(spline, cubes, k: int, gradient_min: float) -> np.ndarray
     >>> distance_estimates(s, [[2, 2, 2]], 2, 4.0).round(9)  # at |grad s| >= 4
     array([0.203125])
     """
-    h = np.asarray(spline.spacing, dtype=np.float64) / int(k)
-    delta = hessian_bounds(spline, cubes) * (h.max() ** 2 / 8.0 + (h ** 2).sum() / 2.0)
+    delta = hessian_bounds(spline, cubes) * value_error_factor(spline.spacing, k)
     with np.errstate(divide="ignore"):
         return delta / gradient_min if gradient_min > 0 else np.full(len(delta), np.inf)
 
