@@ -93,19 +93,10 @@ def _plotter():
 
 def _default_view(model, style):
     """The view pyvista's default camera gives the model (what ``add_spline(max_error_px=...)`` chooses for)."""
-    import numpy as np
-
-    from splinevis.choice import _model_bounds, _program
-    from splinevis.gl.screen_error import View
+    from splinevis.choice import fit_default_camera
 
     pl = _plotter()
-    b = _model_bounds(model, _program(model, None), style)
-    ren = pl.renderer
-    centre = np.array([b[0] + b[1], b[2] + b[3], b[4] + b[5]]) / 2.0
-    ren.camera_position = [centre + np.asarray(pl.theme.camera.position, dtype=np.float64), centre,
-                           pl.theme.camera.viewup]
-    ren.ResetCamera(*b)
-    view = View.from_renderer(ren, pl.window_size)
+    view = fit_default_camera(pl, model, style)
     camera = pl.camera_position
     pl.close()
     return view, camera

@@ -59,12 +59,12 @@ import math
 import numpy as np
 
 from .gl.error_bounds import depth_error
-from .gl.renderers import Choice, Option, Renderer
+from .gl.renderers import Choice, Option, Renderer, model_bounds
 from .gl.screen_error import SNAP_PX, View
 from .plotting_options import split_read_options
 
 __all__ = ["Renderer", "Option", "Choice", "TRIANGLE_CAP", "choose", "renderers_for", "check_max_error", "check_requests",
-           "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px", "add_renderer"]
+           "add_by_accuracy", "add_model_by_accuracy", "raycast_error_px", "add_renderer", "fit_default_camera"]
 
 log = logging.getLogger("splinevis")
 
@@ -288,10 +288,9 @@ def choose(model, view: View, max_error_px: float | None, style=None, *, program
 def _model_bounds(model, program, style):
     """World bounds the default camera is fitted to: ``model.bounds`` if the model has them, else those of
     what the program builds (its proxy, or its dataset)."""
-    b = getattr(model, "bounds", None)
-    b = b() if callable(b) else b  # an attribute (pyvista, our splines) or a method (NurbsModel)
+    b = model_bounds(model)
     if b is not None:
-        return tuple(float(v) for v in b)
+        return b
     built = program.make(model, style)
     if hasattr(built, "bounds"):
         return tuple(built.bounds)
@@ -356,7 +355,6 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     >>> pl.close()
     """
     import os
-    from functools import partial
 
     from vtkmodules.vtkRenderingCore import vtkCamera
 
@@ -373,15 +371,8 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
             raise TypeError(f"program {prog.name!r} draws {prog.model_type.__name__}, not {type(model).__name__}.")
         model = prog.model_from(model)
     ren = plotter.renderer
-    if not ren.camera_set:  # pyvista's view at the first render: the theme's direction, fitted to the bounds
-        b = list(_model_bounds(model, prog, style))
-        vb = ren.ComputeVisiblePropBounds()
-        if vb[0] <= vb[1]:
-            b = [min(b[i], vb[i]) if i % 2 == 0 else max(b[i], vb[i]) for i in range(6)]
-        centre = np.array([b[0] + b[1], b[2] + b[3], b[4] + b[5]]) / 2.0
-        theme = plotter.theme.camera
-        ren.camera_position = [centre + np.asarray(theme.position, dtype=np.float64), centre, theme.viewup]
-        ren.ResetCamera(*b)
+    if not ren.camera_set:
+        fit_default_camera(plotter, model, style, program=prog)
     cam = ren.GetActiveCamera()
     saved = vtkCamera()
     saved.DeepCopy(cam)
@@ -394,9 +385,7 @@ def add_model_by_accuracy(plotter, model, style, max_error_px, *, add_options=No
     choice = choose(model, View.from_renderer(ren, plotter.window_size), max_error_px, style, program=prog,
                     cache=cache, exclude=exclude, max_normal_error_deg=max_normal_error_deg)
     def build(c, options):
-        entry = next(r for r in rows if r.name == c.renderer)
-        return (entry.build or partial(_add_own, renderer=entry))(plotter, model, style, c.level, cache, options,
-                                                                  add_options)
+        return _build(plotter, model, style, rows, c.renderer, c.level, cache, options, add_options)
 
     actor = build(choice, spline_options)
     cam.DeepCopy(saved)
@@ -424,17 +413,50 @@ def add_renderer(plotter, model, style, name: str, level=None, *, program=None, 
     128
     >>> pl.close()
     """
-    from functools import partial
-
     prog = _program(model, program)
     rows, _ = renderers_for(prog)
-    entry = next((r for r in rows if r.name == name), None)
-    if entry is None:
-        raise ValueError(f"program {prog.name!r} has no renderer {name!r}; it has {[r.name for r in rows]}.")
     cache = {} if cache is None else cache
     cache["program"] = prog
-    build = entry.build or partial(_add_own, renderer=entry)
-    return build(plotter, model, style, level, cache, {}, None)
+    return _build(plotter, model, style, rows, name, level, cache, {}, None)
+
+
+def _build(plotter, model, style, rows, name, level, cache, spline_options, add_options):
+    """Draw ``model`` with the renderer named ``name`` among ``rows`` at ``level``: its ``build``, or the program
+    itself with the renderer's program options (:func:`_add_own`)."""
+    entry = next((r for r in rows if r.name == name), None)
+    if entry is None:
+        raise ValueError(f"program {cache['program'].name!r} has no renderer {name!r}; it has "
+                         f"{[r.name for r in rows]}.")
+    if entry.build is not None:
+        return entry.build(plotter, model, style, level, cache, spline_options, add_options)
+    return _add_own(plotter, model, style, level, cache, spline_options, add_options, entry)
+
+
+def fit_default_camera(plotter, model, style=None, *, program=None) -> View:
+    """Set ``plotter``'s camera to pyvista's view at the first render: the theme's direction, fitted to the
+    model's bounds (:func:`_model_bounds`) and those of what the plotter already shows; return that view (what
+    :func:`add_model_by_accuracy` chooses for when no camera was set).
+
+    >>> from splinevis.analytic import QuarticTrianglePatch
+    >>> from splinevis.plotting import Plotter
+    >>> pl = Plotter(off_screen=True, window_size=(64, 48))
+    >>> v = fit_default_camera(pl, QuarticTrianglePatch.demo())
+    >>> v.width, v.height, bool(pl.renderer.camera_set)
+    (64, 48, True)
+    >>> pl.close()
+    """
+    from .effects import Style
+
+    ren = plotter.renderer
+    b = list(_model_bounds(model, _program(model, program), Style() if style is None else style))
+    vb = ren.ComputeVisiblePropBounds()
+    if vb[0] <= vb[1]:
+        b = [min(b[i], vb[i]) if i % 2 == 0 else max(b[i], vb[i]) for i in range(6)]
+    centre = np.array([b[0] + b[1], b[2] + b[3], b[4] + b[5]]) / 2.0
+    theme = plotter.theme.camera
+    ren.camera_position = [centre + np.asarray(theme.position, dtype=np.float64), centre, theme.viewup]
+    ren.ResetCamera(*b)
+    return View.from_renderer(ren, plotter.window_size)
 
 
 def _set_attribute(actor, key, value):

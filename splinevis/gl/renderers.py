@@ -25,7 +25,7 @@ from .error_bounds import U32
 from .screen_error import View
 
 __all__ = ["Renderer", "Option", "Choice", "MESH_LEVELS", "float32_margin", "mesh_refuses", "add_mesh_actor",
-           "MESH_NS_PER_PIXEL", "MESH_NS_PER_TRIANGLE", "estimated_ms", "model_box", "raycast_cost", "mesh_cost"]
+           "MESH_NS_PER_PIXEL", "MESH_NS_PER_TRIANGLE", "estimated_ms", "model_bounds", "model_box", "raycast_cost", "mesh_cost"]
 
 #: Samples per cell (or cube) tried for sampled meshes, in order of cost.
 MESH_LEVELS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64)
@@ -255,16 +255,28 @@ def estimated_ms(view, lo, hi, *, ns_per_pixel: float, triangles: int = 0) -> fl
     return (ns_per_pixel * view.box_area_pixels(lo, hi) + MESH_NS_PER_TRIANGLE * triangles) * 1e-6
 
 
+def model_bounds(model) -> tuple | None:
+    """``model.bounds`` as six floats ``(xmin, xmax, ymin, ymax, zmin, zmax)``, an attribute (pyvista, our
+    splines) or a method (NurbsModel); None when the model has none.
+
+    >>> import pyvista as pv
+    >>> model_bounds(pv.Box()), model_bounds(object())
+    ((-1.0, 1.0, -1.0, 1.0, -1.0, 1.0), None)
+    """
+    b = getattr(model, "bounds", None)
+    b = b() if callable(b) else b
+    return None if b is None else tuple(float(v) for v in b)
+
+
 def model_box(model, cache) -> tuple:
-    """``(lo, hi)`` of ``model.bounds`` (an attribute or a method), kept in ``cache``.
+    """``(lo, hi)`` of :func:`model_bounds`, kept in ``cache``.
 
     >>> import pyvista as pv
     >>> [v.tolist() for v in model_box(pv.Box(), {})]
     [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]
     """
     if "box" not in cache:
-        b = model.bounds
-        b = b() if callable(b) else b
+        b = model_bounds(model)
         cache["box"] = (np.array(b[0::2], dtype=np.float64), np.array(b[1::2], dtype=np.float64))
     return cache["box"]
 
