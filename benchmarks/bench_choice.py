@@ -21,8 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import statistics
-import time
 from pathlib import Path
 
 PIXELS = (2.0, 1.0, 0.5, 0.25, 0.1)
@@ -104,6 +102,7 @@ def _default_view(model, style):
 
 def bench_family(family: str, repeats: int = 5) -> dict:
     """Choices per request, measured errors and frame times of one family's scene (module docstring)."""
+    from splinevis.analysis.timing import interleaved_frame_times
     from splinevis.choice import add_renderer, choose, renderers_for
     from splinevis.effects import Style
     from splinevis.programs import program_for
@@ -142,19 +141,10 @@ def bench_family(family: str, repeats: int = 5) -> dict:
             add_renderer(pl, model, style, key[0], key[1], cache=cache)
         pl.camera_position = camera
         scenes[key] = pl
-    for pl in scenes.values():
-        pl.render_now()
-        pl.render_now()
-    times = {k: [] for k in scenes}
-    for _ in range(repeats):
-        for k, pl in scenes.items():
-            t0 = time.perf_counter()
-            pl.render_now()
-            times[k].append(1e3 * (time.perf_counter() - t0))
+    frame = dict(zip(scenes, interleaved_frame_times(scenes.values(), repeats)))
     shots = {k: pl.screenshot(return_img=True) for k, pl in scenes.items()}
     for pl in scenes.values():
         pl.close()
-    frame = {k: {"min_ms": min(v), "median_ms": statistics.median(v)} for k, v in times.items()}
     exact_ms = frame[("exact program", None)]["min_ms"]
     if own is not None:
         frame[own] = frame[("exact program", None)]

@@ -21,9 +21,7 @@ exactness still costs over a mesh of the same size).
 from __future__ import annotations
 
 import json
-import statistics
 import sys
-import time
 from pathlib import Path
 
 WINDOW = (800, 600)
@@ -49,6 +47,7 @@ def measure(repeats):
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from bench_profile import CAMERA, _terrain
 
+    from splinevis.analysis.timing import interleaved_frame_times
     from splinevis.plotting import Plotter
 
     terrain = _terrain()
@@ -68,21 +67,13 @@ def measure(repeats):
             tris = mesh.n_cells
         pl.camera_position = CAMERA
         pl.camera.clipping_range = (0.01, 10.0)
-        pl.render_now()
-        pl.render_now()
         scenes.append((name, pl, tris))
-    times = [[] for _ in scenes]
-    for _ in range(repeats):
-        for (_, pl, _), t in zip(scenes, times):
-            t0 = time.perf_counter()
-            pl.render_now()
-            t.append(time.perf_counter() - t0)
     rows = []
-    for (name, pl, tris), t in zip(scenes, times):
+    for (name, pl, tris), f in zip(scenes, interleaved_frame_times([s[1] for s in scenes], repeats)):
         covered = float((pl.depth_buffer() < 1.0).mean())
         pl.close()
-        rows.append({"config": name, "triangles": tris, "hit_pixels": covered, "min_ms": 1e3 * min(t),
-                     "median_ms": 1e3 * statistics.median(t), "repeats": repeats})
+        rows.append({"config": name, "triangles": tris, "hit_pixels": covered, "min_ms": f["min_ms"],
+                     "median_ms": f["median_ms"], "repeats": repeats})
     return rows
 
 

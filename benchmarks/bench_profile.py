@@ -65,10 +65,9 @@ def measure(configs, repeats):
 
     All configurations are open at once and timed in turn, one frame each per round (after two warm-up
     frames): load from other processes then falls on all of them alike, and each one's fastest frame is
-    one taken in a quiet moment.
+    one taken in a quiet moment (:func:`splinevis.analysis.timing.interleaved_frame_times`).
     """
-    import statistics
-    import time
+    from splinevis.analysis.timing import interleaved_frame_times
 
     terrain = _terrain()
     scenes = []
@@ -76,21 +75,13 @@ def measure(configs, repeats):
         pl, actor = _plotter(terrain, debug, iterations)
         if steps is not None:
             actor.extra_uniforms["sv_march_steps"] = int(steps)
-        pl.render_now()
-        pl.render_now()
         scenes.append(pl)
-    times = [[] for _ in scenes]
-    for _ in range(repeats):
-        for pl, t in zip(scenes, times):
-            t0 = time.perf_counter()
-            pl.render_now()
-            t.append(time.perf_counter() - t0)
     rows = []
-    for (name, _, steps, _), pl, t in zip(configs, scenes, times):
+    for (name, _, steps, _), pl, f in zip(configs, scenes, interleaved_frame_times(scenes, repeats)):
         covered = float((pl.depth_buffer() < 1.0).mean())
         pl.close()
-        rows.append({"config": name, "march_steps": steps, "hit_pixels": covered, "min_ms": 1e3 * min(t),
-                     "median_ms": 1e3 * statistics.median(t), "repeats": repeats})
+        rows.append({"config": name, "march_steps": steps, "hit_pixels": covered, "min_ms": f["min_ms"],
+                     "median_ms": f["median_ms"], "repeats": repeats})
     return rows
 
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 import os
 import statistics
 import sys
-import time
 from pathlib import Path
 
 WINDOW = (800, 600)
@@ -69,6 +68,7 @@ def bench_speedup(repeats):
     """The frame-time ratios today / new (module docstring): a dict with the rows and the load averages."""
     import numpy as np
 
+    from splinevis.analysis.timing import interleaved_frame_times
     from splinevis.plotting import Plotter
 
     load_before = os.getloadavg()
@@ -79,15 +79,8 @@ def bench_speedup(repeats):
             actor = build(pl)
             if which == "today":
                 actor.set_variant(LEGACY[family])
-            pl.render_now()
-            pl.render_now()
             plotters.append((name, family, which, pl))
-    times = [[] for _ in plotters]
-    for _ in range(repeats):
-        for (_, _, _, pl), t in zip(plotters, times):
-            t0 = time.perf_counter()
-            pl.render_now()
-            t.append(time.perf_counter() - t0)
+    times = [f["seconds"] for f in interleaved_frame_times([p[3] for p in plotters], repeats)]
     rows = []
     for k in range(0, len(plotters), 2):
         name, family, _, old = plotters[k]
@@ -136,6 +129,7 @@ def volume_parts(repeats):
     import statistics as st
 
     from run import VOLUME_VIEWS
+    from splinevis.analysis.timing import interleaved_frame_times
     from splinevis.plotting import Plotter
 
     spline, iso = _volume("quadratic")
@@ -150,15 +144,8 @@ def volume_parts(repeats):
         pl.camera_position = VOLUME_VIEWS["full"]
         pl.camera.view_angle = 30
         pl.camera.clipping_range = (0.01, 10.0)
-        pl.render_now()
-        pl.render_now()
         scenes.append((label, pl, actor))
-    times = [[] for _ in scenes]
-    for _ in range(repeats):
-        for (_, pl, _), t in zip(scenes, times):
-            t0 = time.perf_counter()
-            pl.render_now()
-            t.append(time.perf_counter() - t0)
+    times = [f["seconds"] for f in interleaved_frame_times([s[1] for s in scenes], repeats)]
     rows = []
     for (label, pl, actor), t in zip(scenes, times):
         covered = int((pl.depth_buffer() < 1.0).sum())

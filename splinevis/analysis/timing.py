@@ -5,7 +5,7 @@ from __future__ import annotations
 import statistics
 import time
 
-__all__ = ["frame_times"]
+__all__ = ["frame_times", "interleaved_frame_times"]
 
 
 def frame_times(plotter, repeats: int = 5) -> dict:
@@ -24,11 +24,34 @@ def frame_times(plotter, repeats: int = 5) -> dict:
     (3, True)
     >>> pl.close()
     """
-    plotter.render_now()
-    plotter.render_now()
-    times = []
+    r = interleaved_frame_times([plotter], repeats)[0]
+    return {k: r[k] for k in ("min_ms", "median_ms", "repeats")}
+
+
+def interleaved_frame_times(plotters, repeats: int = 5, warmup: int = 2) -> list:
+    """Time ``repeats`` rounds of frames of several plotters side by side: ``warmup`` untimed frames each first,
+    then one frame of every plotter per round, so that load from other processes falls on all alike (the
+    fastest frame is the quiet one). One dict per plotter: ``{"min_ms", "median_ms", "repeats", "seconds"}``
+    (``seconds``: every timed frame).
+
+    >>> import pyvista as pv
+    >>> from splinevis.plotting import Plotter
+    >>> pls = [Plotter(off_screen=True, window_size=(32, 24)) for _ in range(2)]
+    >>> _ = pls[0].add_mesh(pv.Sphere()); _ = pls[1].add_mesh(pv.Cube())
+    >>> rows = interleaved_frame_times(pls, repeats=3)
+    >>> [len(r["seconds"]) for r in rows], all(0.0 < r["min_ms"] <= r["median_ms"] for r in rows)
+    ([3, 3], True)
+    >>> for pl in pls: pl.close()
+    """
+    plotters = list(plotters)
+    for pl in plotters:
+        for _ in range(warmup):
+            pl.render_now()
+    times = [[] for _ in plotters]
     for _ in range(repeats):
-        t0 = time.perf_counter()
-        plotter.render_now()
-        times.append(time.perf_counter() - t0)
-    return {"min_ms": 1e3 * min(times), "median_ms": 1e3 * statistics.median(times), "repeats": repeats}
+        for pl, t in zip(plotters, times):
+            t0 = time.perf_counter()
+            pl.render_now()
+            t.append(time.perf_counter() - t0)
+    return [{"min_ms": 1e3 * min(t), "median_ms": 1e3 * statistics.median(t), "repeats": repeats, "seconds": t}
+            for t in times]
