@@ -10,7 +10,7 @@ pytestmark = pytest.mark.gl
 
 
 def test_showcase_figures_are_written_and_show_something(tmp_path):
-    written = render_showcase(tmp_path, progress=False)
+    written = render_showcase(tmp_path, progress=False, scale=0.5)  # the same code on a quarter of the pixels
     assert set(written) == {"composite", "composite_check", "effects", "terrain", "volume", "nurbs",
                             "geometry_image"}
     for name, path in written.items():

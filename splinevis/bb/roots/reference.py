@@ -175,7 +175,10 @@ def roots_reference(c) -> np.ndarray:
             f, fp = _eval_deriv(c3, xe, np.float64)
             xn = np.clip(xe - f / np.where(fp != 0.0, fp, np.inf), 0.0, 1.0)
             fn, _ = _eval_deriv(c3, xn, np.float64)
-            xe = np.where(np.abs(fn) < np.abs(f), xn, xe)
+            step = np.abs(fn) < np.abs(f)
+            if not step.any():  # no candidate moves: every later step would repeat this one
+                break
+            xe = np.where(step, xn, xe)
         f, _ = _eval_deriv(c3, xe, np.float64)
         S, _ = _eval_deriv(np.abs(c3), xe, np.float64)
         xe = np.where(np.abs(f) <= 16 * n * np.finfo(np.float64).eps * S, xe, np.nan)
