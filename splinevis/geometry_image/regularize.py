@@ -66,11 +66,14 @@ def smoothing_steps(oversample: int, sigma_cells: float = SIGMA_CELLS) -> int:
     return int(np.ceil(2.0 * (float(sigma_cells) * int(oversample)) ** 2 / ALPHA))
 
 
-def smooth_samples(points, faces, samples, sample_faces, steps: int) -> tuple:
+def smooth_samples(points, faces, samples, sample_faces, steps: int, *, turn_guard: bool = True) -> tuple:
     """``(samples, kept)``: the ``(M, M, 3)`` grid of mesh points ``samples`` (each on triangle
     ``sample_faces[i]`` of the mesh ``(points, faces)``) after ``steps`` steps of smoothing along the mesh (module
     docstring), and the share of samples the last step kept in place (at a feature, or their closest point on a
-    triangle turned away: a jump across a thin part, not a move along the surface).
+    triangle turned away: a jump across a thin part, not a move along the surface). ``turn_guard=False`` lets
+    the samples where the surface turns by more than :data:`FLAT_COS` within a grid step move too (the jump
+    guard stays): what mends the ripples along a sharp crease where the grid is fine enough, and squeezes a
+    protrusion where it is not (:func:`.build.geometry_image_from_mesh` tries it when the guarded grid folds).
 
     >>> from datasets_synthetic.closed_meshes import ellipsoid_mesh
     >>> from splinevis.geometry_image.sphere import spherical_parametrization, locate
@@ -104,7 +107,7 @@ def smooth_samples(points, faces, samples, sample_faces, steps: int) -> tuple:
         n = normal[at]
         Np = pad(n.reshape(M, M, 3), 1)  # a sample where the surface turns within a grid step stays: moving it
         flat = np.ones(len(X), dtype=bool)  # along the tangent plane would leave the feature (a leg's tip)
-        for q in (Np[:-2, 1:-1], Np[2:, 1:-1], Np[1:-1, :-2], Np[1:-1, 2:]):
+        for q in (Np[:-2, 1:-1], Np[2:, 1:-1], Np[1:-1, :-2], Np[1:-1, 2:]) if turn_guard else ():
             flat &= np.einsum("ij,ij->i", q.reshape(-1, 3), n) >= FLAT_COS
         move = mean - X
         move -= np.einsum("ij,ij->i", move, n)[:, None] * n
