@@ -17,7 +17,7 @@ time of every stage, the parametrization's stretch and the distances.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -67,6 +67,9 @@ class BuildReport:
         normal points into the mesh (:func:`.measure.reversed_normals`); empty when not measured.
         :data:`FOLDED_WARNING` applies to ``fraction``, :data:`REVERSED_WARNING` to ``reversed``; with
         ``fairness="auto"``, ``"fairness_tried"`` and ``"reversed_tried"`` list each weight's figures.
+    memory_mb : float
+        The build's peak resident memory above what the process held when it began, in MB
+        (:class:`splinevis.analysis.memory.PeakMemory`, sampled every 5 ms).
     repairs : tuple of str
         What was done to the input to make it one closed triangle mesh (:func:`.repair.prepare_mesh`: welding,
         triangulating, dropping unused points); each also a warning.
@@ -92,6 +95,7 @@ class BuildReport:
     orientation: np.ndarray = field(default_factory=lambda: np.eye(3))
     repairs: tuple = ()
     folds: dict = field(default_factory=dict)
+    memory_mb: float = float("nan")
 
 
 #: Above this fraction of folded limit triangles on level :data:`FOLD_LEVEL` (the check's count, away from the
@@ -263,12 +267,13 @@ def _badness(folds: dict) -> float:
 
 
 def _fold_measure(image, n: int) -> dict:
-    """The check's fold count (:func:`fold_counts` on level :data:`FOLD_LEVEL`) of ``image``."""
-    from .subdivision import subdivide
+    """The check's fold count (:func:`fold_counts` on level :data:`FOLD_LEVEL`) of ``image``, tile by tile
+    (:func:`.tiles.fold_counts_tiled`: the same count; a 257 x 257 image's level 4 held about 12 GB whole)."""
+    import os
 
-    sub = subdivide(image.control, FOLD_LEVEL)
-    count, at_cut = fold_counts(sub.p, sub.n)
-    del sub
+    from .tiles import fold_counts_tiled
+
+    count, at_cut = fold_counts_tiled(image.control, FOLD_LEVEL, workers=min(os.cpu_count() or 1, 4))
     triangles = 2 * (2 ** FOLD_LEVEL * (int(n) - 1)) ** 2
     return {"level": FOLD_LEVEL, "triangles": triangles, "folded": count, "fraction": count / triangles,
             "at_cut": at_cut}
@@ -374,6 +379,17 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     >>> gi.n, report.triangles, report.stretch["flipped"] if "flipped" in report.stretch else 0
     (17, 320, 0)
     """
+    from ..analysis.memory import PeakMemory
+
+    with PeakMemory() as memory:
+        image, report = _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
+                               parametrization_options, orientation, sphere_map, smoothing, turn_guard)
+    return image, replace(report, memory_mb=round(memory.peak_mb - memory.start_mb, 1))
+
+
+def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress, parametrization_options,
+           orientation, sphere_map, smoothing, turn_guard):
+    """:func:`geometry_image_from_mesh` without the memory sampling (its warnings point at the caller's caller)."""
     import pyvista as pv
 
     from .repair import prepare_mesh
@@ -388,7 +404,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     if repairs:
         import warnings
 
-        warnings.warn(f"{name}: " + "; ".join(repairs), stacklevel=2)
+        warnings.warn(f"{name}: " + "; ".join(repairs), stacklevel=3)
     seconds = {}
     t0 = time.perf_counter()
     info = check_genus0(mesh, name)
@@ -532,13 +548,13 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
                                  f"a stronger one moves the surface more than {100 * AUTO_FAIRNESS_HAUSDORFF:g}% of "
                                  "the diagonal from the mesh)." if list(folds["fairness_tried"].values())[-1][1]
                                  > AUTO_FAIRNESS_HAUSDORFF else "the fewest folds of the weights tried).")
-                             if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=2)
+                             if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=3)
         if len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
             import warnings
 
             warnings.warn(f"the geometry image of {name} stays {100 * distance['hausdorff']:.2g}% of the diagonal from the "
                           f"mesh at n = {n}, the largest n='auto' tries (goal {100 * AUTO_HAUSDORFF:g}%): detail "
-                          "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=2)
+                          "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=3)
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,

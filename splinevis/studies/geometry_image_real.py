@@ -294,7 +294,9 @@ def _one_mesh(path, out, *, n, level, figure, size, cache_dir):
              "flipped": report.stretch.get("flipped"), "hausdorff": report.distance.get("hausdorff"),
              "rms": report.distance.get("rms"), "folded_fraction": report.folded,
              "folded_limit": int(round(report.folded * M2)) if np.isfinite(report.folded) else None,
-             "limit_triangles": M2, **{f"{k.replace('/', '_')}_s": v for k, v in s.items()},
+             "limit_triangles": M2, "folds_level4": report.folds.get("fraction"),
+             "reversed": report.folds.get("reversed"), "memory_mb": report.memory_mb,
+             **{f"{k.replace('/', '_')}_s": v for k, v in s.items()},
              "total_s": build_s, "warnings": notes}
     build["tried"] = ", ".join(f"{k}: {100 * v:.2g} %" for k, v in build["sizes_tried"].items()) or str(report.n)
     camera = _camera(name, V)
@@ -402,14 +404,17 @@ def real_mesh_markdown(section) -> str:
     md.append(f"{section['note']}. Distances in units of the input's bounding-box diagonal. Build: "
               "`geometry_image_from_mesh(path)` with its defaults; Hausdorff and RMS of the limit surface two "
               "levels finer than level 0 against the input, both ways (its report); folded: those limit "
-              "triangles facing against their corners' normals.\n\n")
+              "triangles facing against their corners' normals; folds level 4 and inside out: the shares the check "
+              "judges (thresholds 1e-4 and 1e-3); peak MB: the build's resident memory above the process's at its "
+              "start.\n\n")
     md.append(md_table(section["build"], [
         ("mesh", "mesh", "s"), ("triangles in", "triangles_in", "int"), ("n", "n", "s"),
         ("Hausdorff per n tried", "tried", "s"), ("stretch L2", "stretch_l2", "f2"),
         ("stretch max", "stretch_max", "f2"), ("flipped", "flipped", "s"), ("Hausdorff", "hausdorff", "e"),
         ("RMS", "rms", "e"), ("folded", "folded_limit", "int"), ("of limit triangles", "limit_triangles", "int"),
+        ("folds level 4 (check)", "folds_level4", "e"), ("inside out (check)", "reversed", "e"),
         ("parametrize s", "parametrize_s", "f1"), ("sample s", "sample_s", "f1"), ("fit s", "fit_s", "f1"),
-        ("measure s", "measure_s", "f1"), ("total s", "total_s", "f1")]))
+        ("measure s", "measure_s", "f1"), ("total s", "total_s", "f1"), ("peak MB", "memory_mb", "int")]))
     md.append(f"\nAt equal triangle counts: the image at level {lv:g} (the float64 twin of what is drawn) against "
               "the MeshLab subdivisions of the input nearest in triangles (ratio to the image's). Hausdorff: "
               "symmetric; mean: area-weighted, drawn to input. Normal error: each drawn vertex's normal (the "
