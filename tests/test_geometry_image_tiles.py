@@ -42,3 +42,14 @@ def test_tiled_fold_count_equals_the_whole_levels(n, level, amplitude, cells, wo
     expected = fold_counts(s.p, s.n)
     assert expected[0] > 0  # the crumpled image does fold (not a trivial equality)
     assert fold_counts_tiled(G, level, cells, workers) == expected
+
+
+@pytest.mark.parametrize("step", [2, 4])
+def test_tiled_fold_count_of_a_subsampled_level_equals_the_whole_grids(step):
+    G = _crumpled(17, 0.2, 3)
+    s = subdivide(G, 3)
+    expected = fold_counts(s.p[::step, ::step], s.n[::step, ::step])
+    assert expected[0] > 0
+    assert fold_counts_tiled(G, 3, 4, step=step) == expected
+    with pytest.raises(ValueError, match="power of two"):
+        fold_counts_tiled(G, 3, 4, step=3)

@@ -162,18 +162,19 @@ def _input_arrays(mesh):
     return V, F
 
 
-def _folds(P, N, M):
-    """``(folded, at_cut)``: triangles turned against the normals at their corners, away from the four cut
-    vertices and at them, of the ``M x M`` grid of limit points ``P`` and normals ``N`` (:func:`.build.fold_counts`)."""
-    from .build import fold_counts
-
-    return fold_counts(P.reshape(M, M, 3), N.reshape(M, M, 3))
-
-
-def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = None) -> dict:
+def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = None, *, cells: int | None = None) -> dict:
     """The accuracy figures of the geometry image ``model`` against the triangle mesh ``mesh`` (module docstring),
     the limit surface subdivided ``measure_level`` times; folds also on the drawn level ``drawn_level`` (at most
     ``measure_level``; None: ``measure_level - 1``), the same limit points subsampled.
+
+    The limit surface is made tile by tile (:func:`.tiles.limit_tiles`, ``cells`` control cells a side, by
+    default :data:`.tiles.TILE_CELLS`), so a 257 x 257 image at level 4 (33 million triangles, about 12 GB
+    whole) is measured in blocks of a million points: the distances of :func:`.measure.surface_distance` (each
+    limit point and triangle centroid to the mesh, maximum and sum of squares over the tiles; each mesh sample to
+    the nearest tile, the least over the tiles), the fold counts of :func:`.build.fold_counts` and
+    :func:`.build.folded_fraction` (:func:`.tiles.fold_counts_tiled`) and the reversed points
+    (:func:`.measure.reversed_normals` on the level-:data:`REVERSED_LEVEL` points, the cut vertices left out),
+    each the whole level's (the RMS up to the order of its sum).
 
     Examples
     --------
@@ -184,51 +185,75 @@ def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = 
     >>> m["limit_triangles"], m["folded_triangles"], m["drawn_folded"], bool(m["hausdorff"] < 0.03)
     (8192, 0, 0, True)
     """
-    from .build import folded_fraction, limit_mesh_arrays
-    from .measure import surface_distance
-    from .subdivision import grid_faces
-
-    V, F = _input_arrays(mesh)
-    P, N, T = limit_mesh_arrays(model, measure_level)
-    M = int(round(math.sqrt(len(P))))
-    out = dict(surface_distance(P, T, V, F))
-    folded, at_cut = _folds(P, N, M)
-    out.update(measure_level=int(measure_level), limit_triangles=int(len(T)), folded_triangles=folded,
-               folded_fraction=folded / len(T), cut_vertex_folded=at_cut)
-    drawn = max(int(measure_level) - 1, 0) if drawn_level is None else min(int(drawn_level), int(measure_level))
-    step = 1 << (int(measure_level) - drawn)
-    Md = (M - 1) // step + 1
-    Pd = P.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
-    Nd = N.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
-    out.update(drawn_level=drawn, drawn_folded=_folds(Pd, Nd, Md)[0])
-    # the build's own count (BuildReport.folded): every triangle, the cut vertices' included, on its level
-    bl = min(BUILD_FOLD_LEVEL, int(measure_level))
-    step = 1 << (int(measure_level) - bl)
-    Mb = (M - 1) // step + 1
-    Pb = P.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
-    Nb = N.reshape(M, M, 3)[::step, ::step].reshape(-1, 3)
-    out.update(build_fold_level=bl, build_folded_fraction=folded_fraction(Pb, Nb, grid_faces(Mb)))
-    out.update(_reversed(P, N, M, int(measure_level), V, F))
-    out.update(input_vertices=int(len(V)), input_triangles=int(len(F)), n=int(model.n))
-    return out
-
-
-def _reversed(P, N, M, level, V, F) -> dict:
-    """Limit points on the level-:data:`REVERSED_LEVEL` grid whose exact normal is more than 120 degrees from the
-    outward normal of the input triangle closest to them, where the input itself does not fold (no neighbour of
-    the closest triangle faces more than 120 degrees away from it); module docstring."""
     import igl
 
     from .image import cut_vertices
     from .measure import reversed_normals
+    from .subdivision import grid_faces
+    from .tiles import TILE_CELLS, count_folds, fold_counts_tiled, limit_tiles
 
-    step = 1 << max(level - REVERSED_LEVEL, 0)
-    grid = np.zeros((M, M), bool)
-    grid[::step, ::step] = True
-    grid.ravel()[cut_vertices(M) @ np.array([M, 1])] = False
-    idx = np.flatnonzero(grid.ravel())
-    _, closest, _ = igl.point_mesh_squared_distance(np.ascontiguousarray(P[idx]), V, F)
-    return reversed_normals(N[idx], closest, V, F)
+    V, F = _input_arrays(mesh)
+    L = int(measure_level)
+    cells = TILE_CELLS if cells is None else int(cells)
+    control = model.control
+    M = (1 << L) * (int(model.n) - 1) + 1
+    diagonal = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    if not diagonal > 0:
+        raise ValueError("the reference mesh has a zero bounding box: nothing to measure distances in.")
+    tree = igl.AABB()
+    tree.init(V, F)
+    ref_samples = np.vstack([V, V[F].mean(axis=1)])
+    from_ref = np.full(len(ref_samples), np.inf)  # squared, the least over the tiles
+    to_max, to_sq, to_count = 0.0, 0.0, 0
+    drawn = max(L - 1, 0) if drawn_level is None else min(int(drawn_level), L)
+    bl = min(BUILD_FOLD_LEVEL, L)
+    steps = {"measured": 1, "drawn": 1 << (L - drawn), "build": 1 << (L - bl)}
+    counts = {k: [] for k in steps}
+    rstep = 1 << max(L - REVERSED_LEVEL, 0)
+    cuts = cut_vertices(M)
+    rev = {"reversed_points": 0, "reversed_grid_points": 0, "input_folded_faces": 0}
+    for r, c, p, nrm in limit_tiles(control, L, cells):
+        k = len(p)
+        for key, step in steps.items():
+            counts[key].append(count_folds(p, nrm, step))
+        own = np.ones((k, k), dtype=bool)  # the last row and column belong to the next tile (if there is one)
+        own[-1, :] = r + k == M
+        own[:, -1] &= c + k == M
+        faces = grid_faces(k)
+        Vt = p.reshape(-1, 3)
+        d2 = tree.squared_distance(V, F, np.vstack([Vt[own.ravel()], Vt[faces].mean(axis=1)]))[0]
+        a = np.sqrt(d2) / diagonal
+        to_max, to_sq, to_count = max(to_max, float(a.max())), to_sq + float((a * a).sum()), to_count + a.size
+        from_ref = np.minimum(from_ref, igl.point_mesh_squared_distance(ref_samples, Vt, faces)[0])
+        grid = np.zeros((k, k), dtype=bool)  # the reversed normals: the level-REVERSED_LEVEL points
+        grid[::rstep, ::rstep] = True
+        grid &= own
+        for vr, vc in cuts:
+            if r <= vr < r + k and c <= vc < c + k:
+                grid[vr - r, vc - c] = False
+        idx = np.flatnonzero(grid.ravel())
+        if idx.size:
+            closest = tree.squared_distance(V, F, np.ascontiguousarray(Vt[idx]))[1]
+            part = reversed_normals(nrm.reshape(-1, 3)[idx], closest, V, F)
+            for key in ("reversed_points", "reversed_grid_points"):
+                rev[key] += part[key]
+            rev["input_folded_faces"] = part["input_folded_faces"]
+    b = np.sqrt(from_ref) / diagonal
+    out = {"hausdorff": max(to_max, float(b.max())), "to_reference": to_max, "from_reference": float(b.max()),
+           "rms": float(np.sqrt((to_sq + float((b * b).sum())) / (to_count + b.size))), "diagonal": diagonal}
+    T = 2 * (M - 1) ** 2
+    folded, at_cut = fold_counts_tiled(control, L, cells, step=1, tiles=counts["measured"])
+    out.update(measure_level=L, limit_triangles=T, folded_triangles=folded, folded_fraction=folded / T,
+               cut_vertex_folded=at_cut)
+    out.update(drawn_level=drawn, drawn_folded=fold_counts_tiled(control, L, cells, step=steps["drawn"],
+                                                                 tiles=counts["drawn"])[0])
+    # the build's own count (BuildReport.folded): every triangle, the cut vertices' included, on its level
+    fb, ab = fold_counts_tiled(control, L, cells, step=steps["build"], tiles=counts["build"])
+    out.update(build_fold_level=bl, build_folded_fraction=(fb + ab) / (2 * ((M - 1) // steps["build"]) ** 2))
+    rev["reversed_fraction"] = rev["reversed_points"] / max(rev["reversed_grid_points"], 1)
+    out.update(rev)
+    out.update(input_vertices=int(len(V)), input_triangles=int(len(F)), n=int(model.n))
+    return out
 
 
 def _pixels(fraction: float) -> str:

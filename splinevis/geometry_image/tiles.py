@@ -20,7 +20,7 @@ import numpy as np
 from .image import cut_vertices, pad
 from .subdivision import _cross, _unit, average, cut_normals, limit, split, tangents
 
-__all__ = ["limit_tiles", "fold_counts_tiled", "TILE_CELLS"]
+__all__ = ["limit_tiles", "fold_counts_tiled", "count_folds", "TILE_CELLS"]
 
 #: Control cells per tile side: a level-4 tile of 64 cells has 1025 x 1025 limit points (25 MB a float64 array).
 TILE_CELLS = 64
@@ -77,9 +77,17 @@ def _triangle_folds(P, N, r: int, c: int):
     return (bool(np.cross(b - a, d - a) @ (na + nb + nd) < 0.0), bool(np.cross(d - a, cc - a) @ (na + nd + nc) < 0.0))
 
 
-def _band_folds(P, N) -> int:
-    """Folded triangles of a grid of limit points ``P`` with normals ``N`` (both ``(R, C, 3)``): the count of
-    :func:`.build.fold_counts` before the cut vertices are set apart."""
+def count_folds(P, N, step: int = 1) -> int:
+    """Folded triangles of the grid of limit points ``P`` with normals ``N`` (both ``(R, C, 3)``), every
+    ``step``-th point of each direction taken: the count of :func:`.build.fold_counts` before the cut vertices
+    are set apart (a tile's share of :func:`fold_counts_tiled`).
+
+    >>> i, j = np.mgrid[0:5, 0:5].astype(float)
+    >>> P = np.stack([j, i, 0.0 * i], axis=2); up = np.broadcast_to([0.0, 0.0, 1.0], P.shape)
+    >>> count_folds(P, up), count_folds(P, -up), count_folds(P, -up, 2)
+    (0, 32, 8)
+    """
+    P, N = P[::step, ::step], N[::step, ::step]
     a, b, c, d = P[:-1, :-1], P[:-1, 1:], P[1:, :-1], P[1:, 1:]
     na, nb, nc, nd = N[:-1, :-1], N[:-1, 1:], N[1:, :-1], N[1:, 1:]
     up = np.einsum("ijk,ijk->ij", np.cross(b - a, d - a), na + nb + nd) < 0.0
@@ -87,13 +95,17 @@ def _band_folds(P, N) -> int:
     return int(up.sum() + lo.sum())
 
 
-def fold_counts_tiled(control, level: int, cells: int = TILE_CELLS, workers: int = 1) -> tuple:
+def fold_counts_tiled(control, level: int, cells: int = TILE_CELLS, workers: int = 1, step: int = 1,
+                      tiles=None) -> tuple:
     """``(folded, at_cut)`` of the limit grid of ``control`` subdivided ``level`` times, as
     :func:`.build.fold_counts` counts them on :func:`.subdivision.subdivide`'s points and normals, tile by tile
     (module docstring). The triangles at the four cut vertices (normals there from the level-0 image, as
     :func:`.subdivision.subdivide` sets them) are counted in ``at_cut`` from a small block around each;
     ``workers`` threads share the tiles (numpy releases the interpreter lock in its loops; the counts are integers,
-    so the sum does not depend on the order).
+    so the sum does not depend on the order). ``step``: count on every ``step``-th limit point of each direction
+    (a power of two up to ``2^level``: the grid of a coarser level's points taken from this level's). ``tiles``:
+    the tiles' counts already made (an iterable of ``count_folds(points, normals, step)`` per tile), to share
+    one pass over the tiles with other measures.
 
     >>> from splinevis.geometry_image.image import apply_cut_constraint, image_uv, octahedral_to_sphere
     >>> from splinevis.geometry_image.subdivision import subdivide
@@ -105,14 +117,18 @@ def fold_counts_tiled(control, level: int, cells: int = TILE_CELLS, workers: int
     ((31, 2), (31, 2), (31, 2))
     """
     control = np.asarray(control, dtype=np.float64)
-    level = int(level)
-    step = 1 << level
-    M = step * (control.shape[0] - 1) + 1
+    level, sub = int(level), int(step)
+    if sub < 1 or sub & (sub - 1) or sub > 1 << level:
+        raise ValueError(f"step must be a power of two from 1 to 2^level = {1 << level}, got {step!r}.")
+    scale = (1 << level) // sub  # limit points of the counted grid per control cell
+    M = scale * (control.shape[0] - 1) + 1
 
     def count(tile):
-        return _band_folds(tile[2], tile[3])
+        return count_folds(tile[2], tile[3], sub)
 
-    if int(workers) > 1:
+    if tiles is not None:
+        folded = int(sum(tiles))
+    elif int(workers) > 1:
         from concurrent.futures import ThreadPoolExecutor
 
         with ThreadPoolExecutor(int(workers)) as pool:
@@ -125,10 +141,11 @@ def fold_counts_tiled(control, level: int, cells: int = TILE_CELLS, workers: int
     at_cut = 0
     for k, (vr, vc) in enumerate(cut_vertices(M)):
         # two control cells a side around the cut vertex (a control point), square: limit rows [2^L a, 2^L (a + 2)]
-        i, j = vr // step, vc // step
+        i, j = vr // scale, vc // scale
         a, c = (min(max(x - 1, 0), n_cells - 2) for x in (i, j))
         P, N = _block(g0, a, a + 4, c, c + 4, level)
-        r0, c0 = a * step, c * step
+        P, N = P[::sub, ::sub], N[::sub, ::sub]
+        r0, c0 = a * scale, c * scale
         Ncut = N.copy()
         Ncut[vr - r0, vc - c0] = at_normal[k]
         for cr in (vr - 1, vr):
