@@ -68,8 +68,9 @@ class BuildReport:
         :data:`FOLDED_WARNING` applies to ``fraction``, :data:`REVERSED_WARNING` to ``reversed``; with
         ``fairness="auto"``, ``"fairness_tried"`` and ``"reversed_tried"`` list each weight's figures.
     memory_mb : float
-        The build's peak resident memory above what the process held when it began, in MB
-        (:class:`splinevis.analysis.memory.PeakMemory`, sampled every 5 ms).
+        The peak resident memory of the process while the build ran, in MB (:class:`splinevis.analysis.memory.
+        PeakMemory`, sampled every 5 ms): what the build needs, with what the process held before (the
+        difference would read 0 where the build reuses memory freed earlier in the process).
     repairs : tuple of str
         What was done to the input to make it one closed triangle mesh (:func:`.repair.prepare_mesh`: welding,
         triangulating, dropping unused points); each also a warning.
@@ -398,7 +399,7 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
     with PeakMemory() as memory:
         image, report = _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
                                parametrization_options, orientation, sphere_map, smoothing, turn_guard)
-    return image, replace(report, memory_mb=round(memory.peak_mb - memory.start_mb, 1))
+    return image, replace(report, memory_mb=round(memory.peak_mb, 1))
 
 
 def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress, parametrization_options,

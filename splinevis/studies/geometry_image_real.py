@@ -405,8 +405,8 @@ def real_mesh_markdown(section) -> str:
               "`geometry_image_from_mesh(path)` with its defaults; Hausdorff and RMS of the limit surface two "
               "levels finer than level 0 against the input, both ways (its report); folded: those limit "
               "triangles facing against their corners' normals; folds level 4 and inside out: the shares the check "
-              "judges (thresholds 1e-4 and 1e-3); peak MB: the build's resident memory above the process's at its "
-              "start.\n\n")
+              "judges (thresholds 1e-4 and 1e-3); peak MB: the process's peak resident memory during the build (the "
+              "study's process, meshes built one after another).\n\n")
     md.append(md_table(section["build"], [
         ("mesh", "mesh", "s"), ("triangles in", "triangles_in", "int"), ("n", "n", "s"),
         ("Hausdorff per n tried", "tried", "s"), ("stretch L2", "stretch_l2", "f2"),
