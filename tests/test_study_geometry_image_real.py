@@ -30,6 +30,10 @@ def test_build_row(section):
     assert 0.0 <= b["rms"] <= b["hausdorff"]  # an RMS never exceeds the largest value it averages
     assert b["limit_triangles"] == 2 * ((N - 1) * 4) ** 2 and 0 <= b["folded_limit"] <= b["limit_triangles"]
     assert b["total_s"] > 0 and b["fit_s"] > 0
+    # built in a process of its own: its peak holds at least the imported libraries (numpy, scipy, pyvista: tens of
+    # MB); NaN would mean not measured
+    assert 30.0 < b["memory_mb"] and b["memory_mb"] == b["memory_mb"]
+    assert 0.0 <= b["folds_level4"] <= 1.0 and 0.0 <= b["reversed"] <= 1.0
 
 
 def test_equal_triangle_rows(section):
