@@ -555,7 +555,10 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
                           f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}) and is "
                           f"inside out at {100 * folds['reversed']:.2g}% of its limit points: the "
                           f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
-                          f"{smap.stretch.get('l2_max', float('nan')):.3g}) undersamples part of the mesh; "
+                          f"{smap.stretch.get('l2_max', float('nan')):.3g}; anisotropy median "
+                          f"{smap.stretch.get('anisotropy_median', float('nan')):.3g}, 95th percentile "
+                          f"{smap.stretch.get('anisotropy_p95', float('nan')):.3g}) undersamples part of the mesh "
+                          "(the folds sit where a square of the sphere comes out longest one way on the mesh); "
                           + _guard_words(folds.get("turn_guard_tried", {}))
                           + ("fairness tried (folds, distance): " + ", ".join(
                               f"{f:g}: " + ("folds not counted" if a != a else f"{100 * a:.2g}%") + f", {100 * b:.2g}%"

@@ -162,7 +162,9 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     (module docstring): ``"l2"`` over the mesh (at least 1); ``"l2_max"`` and ``"l2_p95"`` over its triangles,
     ``sqrt(|J_t|^2 / 2)`` normalized alike (below 1: a triangle with more than its share of the sphere);
     ``"area_ratio_max"`` and ``"area_ratio_p95"`` of ``max(r, 1/r)``, ``r`` a triangle's share of the mesh's area
-    over its share of the sphere's; ``"l2_start"``, ``"l2"`` before the relaxation; ``"steps"``, its steps.
+    over its share of the sphere's; ``"anisotropy_median"`` and ``"anisotropy_p95"``, area-weighted over the mesh,
+    of ``sigma_1 / sigma_2`` (:meth:`.stretch.StretchEnergy.anisotropy`: 1 where the map is conformal; the L2
+    stretch does not see it, as it never penalizes a direction the sphere oversamples); ``"l2_start"``, ``"l2"`` before the relaxation; ``"steps"``, its steps.
     ``timings`` has the seconds of ``"validate"``, ``"tutte"``,
     ``"mobius"``, ``"hierarchy"``, ``"relax"``, ``"check"`` and ``"total"``. A map that fails the final
     one-to-one check raises ``RuntimeError`` (each stage keeps the map one-to-one; the check guards against
