@@ -21,6 +21,17 @@ The preconditioner: at a similarity of scale ``s`` the energy's Hessian is the m
 second, converged fastest on our shapes) and adding those weights as a lumped mass gives a symmetric positive
 definite proxy.
 
+The inverse term (``inverse`` > 0): ``inverse s0^4 sum_t area(P_t) |J_t^-1|^2 / 2`` with ``s0^2 = area(P) / (4 pi)``,
+the L2 stretch of the map from the mesh to the sphere, normalized like the first term so that at a map of uniform
+scale both are equal: the symmetric Dirichlet energy [SmithSchaefer2015] of the map scaled to the sphere's area.
+For a 2 x 2 map ``|J^-1|_F^2 = |J|_F^2 / det(J)^2`` and ``det J_t = area(P_t) / area_sphere(Q_t)`` after the
+scaling, so the term is ``|J_flat|^2 area(Q_t) area_sphere(Q_t) / area(P_t)`` per triangle, made of the factors
+the first term has: its gradient is theirs with other coefficients. The L2 stretch alone never penalizes a
+direction in which the sphere oversamples the mesh (a small singular value of ``J``); the inverse term does, so
+it keeps the map nearer conformal where the stretch alone would draw the sphere out into bands
+(:data:`.hierarchy.LEVEL_INVERSE`). With ``inverse = 0`` every operation is the first term's alone (the same bits
+as without the option).
+
 Why our own code: the energy is the spherical parametrization's; libigl gives the cotangent entries.
 """
 
@@ -46,7 +57,8 @@ def _cross(u, v):
 class StretchEnergy:
     """The L2 stretch of maps of the mesh ``(P, F)`` (``(V, 3)`` points, ``(F, 3)`` outward triangles) onto the
     unit sphere, as a function of the vertices' images ``X``: energy, gradient, preconditioner and report
-    (module docstring).
+    (module docstring); ``inverse`` weighs the inverse map's stretch added to the energy (0: the L2 stretch alone;
+    the report is the L2 stretch's either way).
 
     Examples
     --------
@@ -57,7 +69,7 @@ class StretchEnergy:
     True
     """
 
-    def __init__(self, P, F):
+    def __init__(self, P, F, inverse: float = 0.0):
         import igl
         from scipy.sparse import coo_matrix
 
@@ -70,6 +82,10 @@ class StretchEnergy:
         det = self.M[:, 0, 0] * self.M[:, 1, 1] - self.M[:, 0, 1] * self.M[:, 1, 0]  # not np.linalg (machine bits)
         self.area = 0.5 * np.sqrt(np.maximum(det, 0.0))
         self.total = float(np.add.reduce(self.area))
+        # the inverse map's stretch, weighted (:attr:`inverse`): lambda s0^4 with s0^2 = area(P) / (4 pi), so that
+        # the two terms are equal for a map of uniform scale
+        self.inverse = float(inverse)
+        self._w = self.inverse * (self.total / (4.0 * np.pi)) ** 2
         # the mesh's cotangent stiffness per triangle: cot(angle at corner k) / 2 on the edge opposite corner k
         self.cot = np.asarray(igl.cotmatrix_entries(P, F), dtype=np.float64)
         a, b = F[:, [1, 2, 0]], F[:, [2, 0, 1]]  # the edge opposite each corner
@@ -125,6 +141,9 @@ class StretchEnergy:
         4.0
         """
         J2, flat, sph = self._terms(X)[:3]
+        if self._w:
+            return (0.5 * dot(self.area, J2 * flat / sph + (self._w / (self.area * self.area)) * J2 * flat * sph),
+                    float(np.add.reduce(sph)))
         return 0.5 * dot(self.area, J2 * flat / sph), float(np.add.reduce(sph))
 
     def gradient(self, X) -> tuple:
@@ -142,6 +161,10 @@ class StretchEnergy:
         >>> dX = 1e-7 * np.random.default_rng(0).normal(size=X.shape)
         >>> bool(np.isclose(S.energy(X + dX) - S.energy(X - dX), 2 * np.vdot(g, dX), rtol=1e-5))
         True
+        >>> Si = StretchEnergy(m.points, m.faces.reshape(-1, 4)[:, 1:], inverse=2.0)  # with the inverse term
+        >>> Ei, gi, _ = Si.gradient(X)
+        >>> bool(Ei > E and np.isclose(Si.energy(X + dX) - Si.energy(X - dX), 2 * np.vdot(gi, dX), rtol=1e-5))
+        True
         """
         J2, flat, sph, num, den, (i00, i01, i11), (a, b, c, e1, e2) = self._terms(X)
         m00, m01, m11 = self._m
@@ -152,11 +175,16 @@ class StretchEnergy:
         e = 0.5 * self.area * J2  # the flat energy per triangle
         r = flat / sph
         # corner k: r dJ_k + (e / sph) d_flat_k - (e r / sph) d_sph_k, d_sph_k = w (den d_num_k - num d_den_k)
-        dD0 = (-r * self.area) * (e1 * A00 + e2 * A01)
-        dD1 = (-r * self.area) * (e1 * A01 + e2 * A11)
+        if self._w:  # the inverse term e q flat sph, q = w / area^2: its factors' coefficients added
+            q = self._w / (self.area * self.area)
+            kJ, kf, ks = r + q * flat * sph, e / sph + q * e * sph, e * r / sph - q * e * flat
+        else:  # (the stretch alone, in the operations it always had: the same bits)
+            kJ, kf, ks = r, e / sph, e * r / sph
+        dD0 = (-kJ * self.area) * (e1 * A00 + e2 * A01)
+        dD1 = (-kJ * self.area) * (e1 * A01 + e2 * A11)
         n = _cross(e1, e2)
-        n *= (0.5 * e / sph) / np.sqrt(_dot(n, n))  # (e / sph) n / 2
-        beta = (2.0 * e * r / sph) / (num * num + den * den)
+        n *= (0.5 * kf) / np.sqrt(_dot(n, n))  # (e / sph) n / 2
+        beta = (2.0 * ks) / (num * num + den * den)
         bd, bn = beta * den, beta * num
         ca = -dD0 - dD1 + _cross(n, e2 - e1) - bd * _cross(b, c) + bn * (b + c)
         cb = dD0 - _cross(n, e2) - bd * _cross(c, a) + bn * (c + a)
@@ -164,6 +192,8 @@ class StretchEnergy:
         g = np.empty((self.n, 3))
         for j in range(3):
             g[:, j] = np.bincount(self._corners, weights=np.concatenate([ca[j], cb[j], cc[j]]), minlength=self.n)
+        if self._w:
+            return dot(e, r + q * flat * sph), g, sph
         return dot(e, r), g, sph
 
     def preconditioner(self, sph):
