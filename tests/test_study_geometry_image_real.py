@@ -34,6 +34,7 @@ def test_build_row(section):
     # MB); NaN would mean not measured
     assert 30.0 < b["memory_mb"] and b["memory_mb"] == b["memory_mb"]
     assert 0.0 <= b["folds_level4"] <= 1.0 and 0.0 <= b["reversed"] <= 1.0
+    assert 1.0 <= b["anisotropy_median"] <= b["anisotropy_p95"]  # sigma_1 / sigma_2, at least 1 by its definition
 
 
 def test_equal_triangle_rows(section):
@@ -73,10 +74,12 @@ def test_figure_every_panel_drawn(section):
     img = np.asarray(Image.open(out / s["figures"][0]).convert("L"), dtype=float)
     h, w = img.shape
     body = img[int(0.25 * h):]  # below the titles
-    for k in range(4):  # input, Loop, Catmull-Clark, geometry image side by side
-        panel = body[:, k * w // 4:(k + 1) * w // 4]
+    for k in range(4):  # input, Loop, Catmull-Clark, geometry image side by side, then where it folds
+        panel = body[:, k * w // 5:(k + 1) * w // 5]
         # a blank panel is white; a drawn blob with reflection lines covers a good part of it with dark stripes
         assert (panel < 200).mean() > 0.05, k
+    where = body[:, 4 * w // 5:]  # the input in light grey (and the defects in colour, none on this blob)
+    assert (where < 245).mean() > 0.05
 
 
 def test_markdown_and_missing_data(section, tmp_path):

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["surface_distance", "normal_angles", "reversed_normals"]
+__all__ = ["surface_distance", "normal_angles", "reversed_normals", "defect_points"]
 
 
 def _samples(V, F):
@@ -102,3 +102,40 @@ def normal_angles(normals, exact) -> dict:
     angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)))
     return {"max": float(round(angle.max(), 12)), "rms": float(np.sqrt((angle ** 2).mean())),
             "p99": float(np.percentile(angle, 99))}
+
+
+def defect_points(points, normals, faces, V_ref, F_ref) -> dict:
+    """Where a smooth surface, given as limit ``points`` with unit ``normals`` and the triangles ``faces`` between
+    them, folds and is inside out against the reference mesh ``(V_ref, F_ref)``: ``folded``, the centroids of the
+    triangles facing against the sum of their corners' normals (the test of
+    :func:`splinevis.geometry_image.build.folded_fraction`), and ``inside_out``, the points whose normal is more
+    than 120 degrees from the closest reference triangle's where the reference does not fold itself
+    (:func:`reversed_normals`). For pictures: the study's real meshes show them on the input.
+
+    >>> V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])  # a unit square facing +z
+    >>> F = np.array([[0, 1, 2], [0, 2, 3]])
+    >>> up = np.tile([0.0, 0.0, 1.0], (4, 1))
+    >>> d = defect_points(V, up, F, V, F)
+    >>> len(d["folded"]), len(d["inside_out"])
+    (0, 0)
+    >>> d = defect_points(V, -up, F, V, F)  # every normal turned over
+    >>> len(d["folded"]), len(d["inside_out"]), d["folded"][0].round(3).tolist()
+    (2, 4, [0.667, 0.333, 0.0])
+    """
+    import igl
+
+    P = np.ascontiguousarray(points, dtype=np.float64)
+    N = np.asarray(normals, dtype=np.float64)
+    F = np.asarray(faces, dtype=np.int64)
+    V_ref = np.ascontiguousarray(V_ref, dtype=np.float64)
+    F_ref = np.ascontiguousarray(F_ref, dtype=np.int64)
+    orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    folded = np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0
+    _, closest, _ = igl.point_mesh_squared_distance(P, V_ref, F_ref)
+    face_normal = np.cross(V_ref[F_ref[:, 1]] - V_ref[F_ref[:, 0]], V_ref[F_ref[:, 2]] - V_ref[F_ref[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    adjacent, _ = igl.triangle_triangle_adjacency(F_ref)
+    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    closest = np.asarray(closest, dtype=np.int64)
+    against = ~folds_itself[closest] & (np.einsum("ij,ij->i", N, face_normal[closest]) < -0.5)
+    return {"folded": P[F[folded]].mean(axis=1), "inside_out": P[against]}

@@ -286,6 +286,29 @@ def _build(path, n, cache_dir):
     return out
 
 
+def _defect_shot(image, V, F, camera, size, level: int = 2):
+    """The input in grey with the geometry image's folds (centroids of the folded limit triangles, blue) and
+    inside-out limit points (red) on it (:func:`splinevis.geometry_image.measure.defect_points`, on the level the
+    build measures), as a titled shot for the figure row."""
+    import pyvista as pv
+
+    from ..geometry_image.build import limit_mesh_arrays
+    from ..geometry_image.measure import defect_points
+
+    P, N, T = limit_mesh_arrays(image, level)
+    where = defect_points(P, N, T, V, F)
+    del P, N, T
+
+    def add(pl):
+        pl.add_mesh(pv.PolyData(V, faces=pv.CellArray.from_regular_cells(F)), color=(0.85, 0.85, 0.85))
+        for key, color in (("folded", "blue"), ("inside_out", "red")):
+            if len(where[key]):
+                pl.add_mesh(pv.PolyData(where[key]), color=color, point_size=3, render_points_as_spheres=False)
+
+    return (f"folds: {len(where['folded']):,} (blue), inside out: {len(where['inside_out']):,} (red), level {level}",
+            _shot(add, camera, size))
+
+
 def _one_mesh(path, out, *, n, level, figure, size, cache_dir):
     from ..geometry_image.image import cut_vertices
     from ..geometry_image.program import surface_arrays
@@ -302,6 +325,8 @@ def _one_mesh(path, out, *, n, level, figure, size, cache_dir):
     build = {"mesh": name, "triangles_in": report.triangles, "vertices_in": report.vertices, "n": report.n,
              "sizes_tried": {str(k): v for k, v in report.distance.get("sizes_tried", {}).items()},
              "stretch_l2": report.stretch.get("l2"), "stretch_max": report.stretch.get("l2_max"),
+             "anisotropy_median": report.stretch.get("anisotropy_median"),
+             "anisotropy_p95": report.stretch.get("anisotropy_p95"),
              "flipped": report.stretch.get("flipped"), "hausdorff": report.distance.get("hausdorff"),
              "rms": report.distance.get("rms"), "folded_fraction": report.folded,
              "folded_limit": int(round(report.folded * M2)) if np.isfinite(report.folded) else None,
@@ -352,10 +377,12 @@ def _one_mesh(path, out, *, n, level, figure, size, cache_dir):
 
         shots.append((f"geometry image {image.n}x{image.n}, level {level:g}, {gi['triangles']:,} triangles",
                       _shot(lambda pl: pl.add_geometry_image(image, style, level=level), camera, size)))
+        shots.append(_defect_shot(image, V, F, camera, size))
         figure_name = reflection_row_figure(
             out / f"geometry-image_real_{name}.png", shots,
             f"{name}: reflection lines ({style.reflection_lines} stripes) on the input's vertex normals, its Loop and "
-            f"Catmull-Clark subdivisions and the geometry image's exact normals, same camera").name
+            f"Catmull-Clark subdivisions and the geometry image's exact normals, same camera; last: where the "
+            f"image folds and is inside out").name
     return build, rows, figure_name
 
 
@@ -416,12 +443,15 @@ def real_mesh_markdown(section) -> str:
               "`geometry_image_from_mesh(path)` with its defaults; Hausdorff and RMS of the limit surface two "
               "levels finer than level 0 against the input, both ways (its report); folded: those limit "
               "triangles facing against their corners' normals; folds level 4 and inside out: the shares the check "
-              "judges (thresholds 1e-4 and 1e-3); peak MB: the peak resident memory of the build, each in a process of its own "
+              "judges (thresholds 1e-4 and 1e-3); anisotropy: sigma_1 / sigma_2 of the spherical map's triangles "
+              "(how much longer one way than the other a square of the sphere comes out on the mesh), area-weighted "
+              "median and 95th percentile; peak MB: the peak resident memory of the build, each in a process of its own "
               "(Python and the libraries included).\n\n")
     md.append(md_table(section["build"], [
         ("mesh", "mesh", "s"), ("triangles in", "triangles_in", "int"), ("n", "n", "s"),
         ("Hausdorff per n tried", "tried", "s"), ("stretch L2", "stretch_l2", "f2"),
-        ("stretch max", "stretch_max", "f2"), ("flipped", "flipped", "s"), ("Hausdorff", "hausdorff", "e"),
+        ("stretch max", "stretch_max", "f2"), ("anisotropy median", "anisotropy_median", "f2"),
+        ("anisotropy p95", "anisotropy_p95", "f2"), ("flipped", "flipped", "s"), ("Hausdorff", "hausdorff", "e"),
         ("RMS", "rms", "e"), ("folded", "folded_limit", "int"), ("of limit triangles", "limit_triangles", "int"),
         ("folds level 4 (check)", "folds_level4", "e"), ("inside out (check)", "reversed", "e"),
         ("parametrize s", "parametrize_s", "f1"), ("sample s", "sample_s", "f1"), ("fit s", "fit_s", "f1"),
