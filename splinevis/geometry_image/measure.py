@@ -60,6 +60,20 @@ def surface_distance(V, F, V_ref, F_ref, *, closest: bool = False) -> dict:
     return out
 
 
+def _reference_folds(V_ref, F_ref):
+    """The reference triangles' unit normals and which of them fold themselves (a neighbour facing more than 120
+    degrees away): where the closest triangle's normal judges nothing."""
+    import igl
+
+    V_ref = np.asarray(V_ref, dtype=np.float64)
+    F_ref = np.asarray(F_ref, dtype=np.int64)
+    face_normal = np.cross(V_ref[F_ref[:, 1]] - V_ref[F_ref[:, 0]], V_ref[F_ref[:, 2]] - V_ref[F_ref[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    adjacent, _ = igl.triangle_triangle_adjacency(F_ref)
+    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    return face_normal, folds_itself
+
+
 def reversed_normals(normals, closest_face, V_ref, F_ref) -> dict:
     """Points of a smooth surface whose unit ``normals`` are more than 120 degrees from the outward normal of the
     reference triangle closest to them (``closest_face``), where the reference itself does not fold (no
@@ -73,14 +87,7 @@ def reversed_normals(normals, closest_face, V_ref, F_ref) -> dict:
     >>> r["reversed_points"], r["reversed_fraction"], r["input_folded_faces"]
     (1, 0.5, 0)
     """
-    import igl
-
-    V_ref = np.asarray(V_ref, dtype=np.float64)
-    F_ref = np.asarray(F_ref, dtype=np.int64)
-    face_normal = np.cross(V_ref[F_ref[:, 1]] - V_ref[F_ref[:, 0]], V_ref[F_ref[:, 2]] - V_ref[F_ref[:, 0]])
-    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
-    adjacent, _ = igl.triangle_triangle_adjacency(F_ref)
-    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    face_normal, folds_itself = _reference_folds(V_ref, F_ref)
     N = np.asarray(normals, dtype=np.float64)
     judged = ~folds_itself[closest_face]
     against = judged & (np.einsum("ij,ij->i", N, face_normal[closest_face]) < -0.5)
@@ -132,10 +139,7 @@ def defect_points(points, normals, faces, V_ref, F_ref) -> dict:
     orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
     folded = np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0
     _, closest, _ = igl.point_mesh_squared_distance(P, V_ref, F_ref)
-    face_normal = np.cross(V_ref[F_ref[:, 1]] - V_ref[F_ref[:, 0]], V_ref[F_ref[:, 2]] - V_ref[F_ref[:, 0]])
-    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
-    adjacent, _ = igl.triangle_triangle_adjacency(F_ref)
-    folds_itself = (np.einsum("ij,ikj->ik", face_normal, face_normal[np.maximum(adjacent, 0)]) < -0.5).any(axis=1)
+    face_normal, folds_itself = _reference_folds(V_ref, F_ref)
     closest = np.asarray(closest, dtype=np.int64)
     against = ~folds_itself[closest] & (np.einsum("ij,ij->i", N, face_normal[closest]) < -0.5)
     return {"folded": P[F[folded]].mean(axis=1), "inside_out": P[against]}
