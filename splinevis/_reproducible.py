@@ -48,6 +48,19 @@ def weighted_sum(w, X) -> np.ndarray:
     return np.add.reduce(np.asarray(w)[:, None] * X, axis=0)
 
 
+def weighted_quantile(x, w, q: float) -> float:
+    """The ``q`` quantile of ``x`` weighted by ``w`` (the smallest ``x`` with at least ``q`` of the weight at or
+    below it), after a stable sort and a cumulative sum in a fixed order: the same value on every machine.
+
+    >>> weighted_quantile(np.array([3.0, 1.0, 2.0]), np.array([1.0, 1.0, 2.0]), 0.5)
+    2.0
+    """
+    x = np.asarray(x)
+    order = np.argsort(x, kind="stable")
+    c = np.cumsum(np.asarray(w, dtype=np.float64)[order])
+    return float(x[order][min(int(np.searchsorted(c, q * c[-1])), len(c) - 1)])
+
+
 def solve_small(A, b) -> np.ndarray:
     """The solution of ``A x = b`` for one or a batch of ``2 x 2`` or ``3 x 3`` matrices ``A`` (``(..., k, k)``,
     ``b`` ``(..., k)``), by Cramer's rule (the adjugate over the determinant). Singular systems give inf/nan as

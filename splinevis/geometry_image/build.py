@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .fit import fit_geometry_image
-from .measure import reversed_normals, surface_distance
+from .measure import folded_triangles, reversed_normals, surface_distance
 from .model import GeometryImage
 from .regularize import SIGMA_CELLS, smooth_samples, smoothing_steps
 
@@ -123,9 +123,7 @@ def folded_fraction(points, normals, faces) -> float:
     >>> folded_fraction(P, up, np.array([[0, 1, 2]])), folded_fraction(P, -up, np.array([[0, 1, 2]]))
     (0.0, 1.0)
     """
-    P, N, F = (np.asarray(a) for a in (points, normals, faces))
-    orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
-    return float((np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0).mean())
+    return float(folded_triangles(points, normals, faces).mean())
 
 
 def fold_counts(points, normals) -> tuple:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["surface_distance", "normal_angles", "reversed_normals", "defect_points"]
+__all__ = ["surface_distance", "normal_angles", "reversed_normals", "defect_points", "folded_triangles"]
 
 
 def _samples(V, F):
@@ -111,6 +111,21 @@ def normal_angles(normals, exact) -> dict:
             "p99": float(np.percentile(angle, 99))}
 
 
+def folded_triangles(points, normals, faces) -> np.ndarray:
+    """Which triangles ``faces`` of a surface given as ``points`` with unit ``normals`` face against the sum of
+    their corners' normals (their orientation ``(b - a) x (c - a)`` against it): where it folds over. The test of
+    :func:`splinevis.geometry_image.build.folded_fraction` and :func:`defect_points`.
+
+    >>> P = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]); up = np.tile([0.0, 0, 1], (3, 1))
+    >>> F = np.array([[0, 1, 2]])
+    >>> folded_triangles(P, up, F).tolist(), folded_triangles(P, -up, F).tolist()
+    ([False], [True])
+    """
+    P, N, F = (np.asarray(a) for a in (points, normals, faces))
+    orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    return np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0
+
+
 def defect_points(points, normals, faces, V_ref, F_ref) -> dict:
     """Where a smooth surface, given as limit ``points`` with unit ``normals`` and the triangles ``faces`` between
     them, folds and is inside out against the reference mesh ``(V_ref, F_ref)``: ``folded``, the centroids of the
@@ -136,8 +151,7 @@ def defect_points(points, normals, faces, V_ref, F_ref) -> dict:
     F = np.asarray(faces, dtype=np.int64)
     V_ref = np.ascontiguousarray(V_ref, dtype=np.float64)
     F_ref = np.ascontiguousarray(F_ref, dtype=np.int64)
-    orient = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
-    folded = np.einsum("ij,ij->i", orient, N[F].sum(axis=1)) < 0.0
+    folded = folded_triangles(P, N, F)
     _, closest, _ = igl.point_mesh_squared_distance(P, V_ref, F_ref)
     face_normal, folds_itself = _reference_folds(V_ref, F_ref)
     closest = np.asarray(closest, dtype=np.int64)

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._reproducible import dot
+from .._reproducible import dot, weighted_quantile
 
 __all__ = ["StretchEnergy"]
 
@@ -234,13 +234,13 @@ class StretchEnergy:
         tot = float(sph.sum())
         per = np.sqrt(0.5 * J2 * flat / sph * tot / self.total)
         ratio = (self.area / self.total) / (sph / tot)
-        aniso = self.anisotropy(X)
+        ratio = np.maximum(ratio, 1.0 / ratio)
+        aniso = self._anisotropy(J2, flat)
         return {"l2": float(np.sqrt(self.energy(X) * tot) / self.total),
                 "l2_max": float(per.max()), "l2_p95": float(np.percentile(per, 95)),
-                "area_ratio_max": float(np.maximum(ratio, 1.0 / ratio).max()),
-                "area_ratio_p95": float(np.percentile(np.maximum(ratio, 1.0 / ratio), 95)),
-                "anisotropy_median": _weighted_quantile(aniso, self.area, 0.5),
-                "anisotropy_p95": _weighted_quantile(aniso, self.area, 0.95)}
+                "area_ratio_max": float(ratio.max()), "area_ratio_p95": float(np.percentile(ratio, 95)),
+                "anisotropy_median": weighted_quantile(aniso, self.area, 0.5),
+                "anisotropy_p95": weighted_quantile(aniso, self.area, 0.95)}
 
     def anisotropy(self, X) -> np.ndarray:
         """Per triangle, ``sigma_1 / sigma_2`` of the linear map ``J_t`` from the flat triangle on the sphere to the
@@ -259,18 +259,10 @@ class StretchEnergy:
         >>> bool(S4.anisotropy(m.points).max() > 3.9)  # near the equator x: 4 : 1
         True
         """
-        J2, flat = self._terms(X)[:2]
+        return self._anisotropy(*self._terms(X)[:2])
+
+    def _anisotropy(self, J2, flat):
+        """:meth:`anisotropy` from ``|J_flat|^2`` and the flat triangles' areas (:meth:`_terms`)."""
         f = np.maximum(J2 * flat / self.area, 2.0)  # |J|^2 / det J, scale-free (2 for a similarity)
         return 0.5 * (f + np.sqrt(f * f - 4.0))
 
-
-def _weighted_quantile(x, w, q: float) -> float:
-    """The ``q`` quantile of ``x`` weighted by ``w`` (the smallest ``x`` with at least ``q`` of the weight at or
-    below it; a stable sort: the same value on every machine).
-
-    >>> _weighted_quantile(np.array([3.0, 1.0, 2.0]), np.array([1.0, 1.0, 2.0]), 0.5)
-    2.0
-    """
-    order = np.argsort(x, kind="stable")
-    c = np.cumsum(np.asarray(w, dtype=np.float64)[order])
-    return float(x[order][min(int(np.searchsorted(c, q * c[-1])), len(c) - 1)])

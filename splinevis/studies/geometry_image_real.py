@@ -62,6 +62,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._reproducible import weighted_quantile
 from .report import log, md_table, progress_bar
 
 __all__ = ["DEV_MESHES", "mesh_data_dir", "matched_steps", "measure_drawn", "real_mesh_section",
@@ -152,12 +153,6 @@ def _reference_normals(V, F, NV, face, X):
     return N / np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
 
 
-def _weighted_quantile(x, w, q):
-    order = np.argsort(x)
-    c = np.cumsum(w[order])
-    return float(x[order][min(np.searchsorted(c, q * c[-1]), len(x) - 1)])
-
-
 def measure_drawn(P, T, N, V, F, *, skip_folded=None) -> dict:
     """A drawn mesh (points ``P``, triangles ``T``, the normals ``N`` it is lit with) against the input ``(V, F)``
     (module docstring): ``hausdorff`` (symmetric) and ``mean`` (area-weighted, drawn to input) in units of the
@@ -197,7 +192,7 @@ def measure_drawn(P, T, N, V, F, *, skip_folded=None) -> dict:
             "to_input_max": float(to_input.max()), "from_input_max": float(from_input.max()),
             "mean": float(np.average(to_input, weights=w)), "edge_max": float(np.linalg.norm(edges, axis=1).max()) / diag,
             "normal_rms_deg": float(np.sqrt(np.average(angle ** 2, weights=w))),
-            "normal_p99_deg": _weighted_quantile(angle, w, 0.99), "normal_max_deg": float(angle.max()),
+            "normal_p99_deg": weighted_quantile(angle, w, 0.99), "normal_max_deg": float(angle.max()),
             "folded": int((folded & ~skipped).sum()), "folded_skipped": int((folded & skipped).sum())}
 
 
