@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .fit import fit_geometry_image
+from .hierarchy import LEVEL_INVERSE
 from .measure import folded_triangles, reversed_normals, surface_distance
 from .model import GeometryImage
 from .regularize import SIGMA_CELLS, smooth_samples, smoothing_steps
@@ -46,7 +47,9 @@ class BuildReport:
         Per stage: ``check``, ``parametrize`` (and the parametrization's own stages as ``parametrize/...``),
         ``orient``, ``sample``, ``fit``, ``measure``.
     stretch : dict
-        The spherical parametrization's stretch (:class:`.sphere.SphericalMap`).
+        The spherical parametrization's stretch (:class:`.sphere.SphericalMap`), ``"flipped"`` its flipped
+        triangles and, when the build parametrized the mesh itself, ``"level_inverse"`` the inverse-stretch weight
+        of the map kept (:data:`ESCALATE_INVERSE` if the finer image was kept).
     distance : dict
         :func:`.measure.surface_distance` of the fitted surface to the mesh (``hausdorff``, ``rms``, ...), in
         units of the mesh's bounding-box diagonal; empty when not measured.
@@ -66,7 +69,9 @@ class BuildReport:
         counted apart in ``at_cut``), and ``"reversed"``, the share of level-``levels_finer`` limit points whose
         normal points into the mesh (:func:`.measure.reversed_normals`); empty when not measured.
         :data:`FOLDED_WARNING` applies to ``fraction``, :data:`REVERSED_WARNING` to ``reversed``; with
-        ``fairness="auto"``, ``"fairness_tried"`` and ``"reversed_tried"`` list each weight's figures.
+        ``fairness="auto"``, ``"fairness_tried"`` and ``"reversed_tried"`` list each weight's figures;
+        ``"escalation_tried"`` (``n="auto"``, :data:`ESCALATE_INVERSE`) the folded and inside-out fractions and the
+        distance of the first image and of the finer one from the second parametrization.
     memory_mb : float
         The peak resident memory of the process while the build ran, in MB (:class:`splinevis.analysis.memory.
         PeakMemory`, sampled every 5 ms): what the build needs, with what the process held before (the
@@ -216,6 +221,22 @@ AUTO_HAUSDORFF = 0.005
 AUTO_FAIRNESS = (0.1, 0.3, 1.0, 3.0)
 AUTO_FAIRNESS_HAUSDORFF = 0.01
 
+#: What ``n="auto"`` does when the image it chose still folds or is inside out (:func:`_badness` above 1) after
+#: the turn guard and fairness were tried: it parametrizes the mesh again with the inverse map's stretch in the
+#: coarse levels' relaxations (``level_inverse`` = :data:`ESCALATE_INVERSE`, :data:`.hierarchy.LEVEL_INVERSE`'s
+#: comment says why that keeps the coarse levels nearer conformal) and builds an image twice as fine (at most
+#: :data:`ESCALATE_MAX` samples per side); the image less past the thresholds is kept, if it is no farther from
+#: the mesh than ``max(AUTO_FAIRNESS_HAUSDORFF, the first's distance)`` (:func:`_prefer`; ``folds[
+#: "escalation_tried"]`` has both). Why both at once: at n = 257 the thin limbs of the four-legged scan cannot be
+#: sampled evenly and densely at once. Measured (folds at level 4 / inside out / Hausdorff, what the build kept):
+#: beast.obj 0.34 % / 2.5 % / 0.72 % at 257; level_inverse 1 alone 0.038 % / 0.71 % / 0.91 %; n = 513 alone
+#: 0.16 % / 0.48 % / 0.89 %; both 0.020 % / 0.20 % / 0.84 %. armadillo.obj 0.118 % / 0.34 % / 0.93 % at 257;
+#: level_inverse 1 alone 0.118 % / 0.47 % / 0.91 %; both 0.039 % / 0.11 % / 0.49 %. It costs a second
+#: parametrization and an image four times as large: 255-340 s more on those scans. A mesh whose image does not
+#: fold never pays it.
+ESCALATE_INVERSE = 1.0
+ESCALATE_MAX = 513
+
 
 def auto_oversample(n: int, vertices: int) -> int:
     """Samples per control interval for an ``n x n`` image of a mesh of ``vertices`` vertices: at least 2 (two
@@ -306,6 +327,20 @@ def _guard_words(tried: dict) -> str:
     return f"smoothed without the turn guard (folds, inside out, distance: {words}); "
 
 
+def _escalation_words(tried: dict) -> str:
+    """The build warning's account of ``folds["escalation_tried"]`` (:data:`ESCALATE_INVERSE`): empty unless the
+    finer image from the second parametrization was built.
+
+    >>> _escalation_words({"n = 257, level_inverse 0": (1.2e-3, 3.4e-3, 9.3e-3),
+    ...                    "n = 513, level_inverse 1": (3.9e-4, 1.1e-3, 4.9e-3)})
+    'rebuilt from a parametrization nearer conformal (folds, inside out, distance: n = 257, level_inverse 0: 0.12%, 0.34%, 0.93%; n = 513, level_inverse 1: 0.039%, 0.11%, 0.49%); '
+    """
+    if not tried:
+        return ""
+    words = "; ".join(f"{k}: " + ", ".join(f"{100 * x:.2g}%" for x in v) for k, v in tried.items())
+    return f"rebuilt from a parametrization nearer conformal (folds, inside out, distance: {words}); "
+
+
 def _measured(image, n: int, levels_finer: int, smap) -> tuple:
     """``(distance, folds, folded)`` of a fitted ``image`` against the mesh of ``smap``: the report's distance
     (:func:`.measure.surface_distance` on level ``levels_finer``), the check's folds with the inside-out share
@@ -333,7 +368,9 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         Samples per side, odd; ``2^k + 1`` for levels of detail down to the octahedron. ``"auto"`` (default):
         the first of :data:`AUTO_SIZES` whose limit surface is within :data:`AUTO_HAUSDORFF` of the diagonal of
         the mesh (measured; ``distance["sizes_tried"]`` lists each size's distance), with a warning when the
-        largest is not.
+        largest is not; an image that still folds is built again, twice as fine, from a parametrization nearer
+        conformal (:data:`ESCALATE_INVERSE`; not when ``sphere_map`` or ``parametrization_options["level_inverse"]``
+        is given).
     fairness : float or "auto"
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
         leaves in the normals (measured in the geometry-image study) at a small cost in distance. ``"auto"``
@@ -406,7 +443,6 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     import pyvista as pv
 
     from .repair import prepare_mesh
-    from .sphere import locate, spherical_parametrization
     from .validate import check_genus0
 
     if not (turn_guard is True or turn_guard is False or (isinstance(turn_guard, str) and turn_guard == "auto")):
@@ -424,20 +460,91 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     seconds["check"] = time.perf_counter() - t0
 
     if sphere_map is None:
-        t0 = time.perf_counter()
-        smap = spherical_parametrization(mesh, name=name, progress=progress, **(parametrization_options or {}))
-        seconds["parametrize"] = time.perf_counter() - t0
-        for stage, s in smap.timings.items():
-            seconds[f"parametrize/{stage}"] = float(s)
+        smap = _parametrize(mesh, name, progress, parametrization_options or {}, seconds)
     else:
         smap = sphere_map
         if smap.points.shape != (info["vertices"], 3) or not np.array_equal(smap.points, np.asarray(mesh.points)):
             raise ValueError(f"sphere_map is not a parametrization of {name}: its points differ from the mesh's.")
+    R = _orientation(orientation, smap, seconds)
+
+    sizes = AUTO_SIZES if isinstance(n, str) and n == "auto" else (int(n),)
+    if isinstance(n, str) and n != "auto":
+        raise ValueError(f"n must be 'auto' or an odd sample count, got {n!r}.")
+    auto_fairness = isinstance(fairness, str)
+    if auto_fairness and fairness != "auto":
+        raise ValueError(f"fairness must be 'auto' or a number >= 0, got {fairness!r}.")
+    fairness = AUTO_FAIRNESS[0] if auto_fairness else float(fairness)
+    measure = measure or len(sizes) > 1 or auto_fairness
+    settings = dict(fairness=fairness, auto_fairness=auto_fairness, oversample=oversample, measure=measure,
+                    levels_finer=levels_finer, smoothing=smoothing, turn_guard=turn_guard,
+                    vertices=info["vertices"], seconds=seconds)
+    got = _image_from_map(smap, R, sizes, **settings)
+    inverse = (parametrization_options or {}).get("level_inverse")
+    if len(sizes) > 1 and sphere_map is None and inverse is None and got.n < ESCALATE_MAX and _badness(got.folds) > 1:
+        n2 = min(2 * (got.n - 1) + 1, ESCALATE_MAX)
+        smap2 = _parametrize(mesh, name, progress, dict(parametrization_options or {}, level_inverse=ESCALATE_INVERSE),
+                             seconds)
+        got2 = _image_from_map(smap2, _orientation(orientation, smap2, seconds), (n2,), **settings)
+        got2.distance["sizes_tried"] = {**got.distance.get("sizes_tried", {}), n2: float(got2.distance["hausdorff"])}
+        tried_e = {f"n = {k.n}, level_inverse {w:g}": (k.folds["fraction"], k.folds["reversed"],
+                                                       float(k.distance["hausdorff"]))
+                   for k, w in ((got, LEVEL_INVERSE), (got2, ESCALATE_INVERSE))}
+        if _prefer(got2.folds, got2.distance["hausdorff"], got.folds, got.distance["hausdorff"]):
+            got, smap, inverse = got2, smap2, ESCALATE_INVERSE
+        got.folds["escalation_tried"] = tried_e
+    fit, n, fairness, distance, folds, folded = got.fit, got.n, got.fairness, got.distance, got.folds, got.folded
+    if measure and _badness(folds) > 1.0:
+        import warnings
+
+        warnings.warn(f"the geometry image of {name} folds over in {100 * folds['fraction']:.2g}% of its limit "
+                      f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}) and is "
+                      f"inside out at {100 * folds['reversed']:.2g}% of its limit points: the "
+                      f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
+                      f"{smap.stretch.get('l2_max', float('nan')):.3g}; anisotropy median "
+                      f"{smap.stretch.get('anisotropy_median', float('nan')):.3g}, 95th percentile "
+                      f"{smap.stretch.get('anisotropy_p95', float('nan')):.3g}) undersamples part of the mesh "
+                      "(the folds sit where a square of the sphere comes out longest one way on the mesh); "
+                      + _escalation_words(folds.get("escalation_tried", {}))
+                      + _guard_words(folds.get("turn_guard_tried", {}))
+                      + ("fairness tried (folds, distance): " + ", ".join(
+                          f"{f:g}: " + ("folds not counted" if a != a else f"{100 * a:.2g}%") + f", {100 * b:.2g}%"
+                          for f, (a, b) in folds["fairness_tried"].items())
+                         + f"; kept {fairness:g} (" + (
+                             f"a stronger one moves the surface more than {100 * AUTO_FAIRNESS_HAUSDORFF:g}% of "
+                             "the diagonal from the mesh)." if list(folds["fairness_tried"].values())[-1][1]
+                             > AUTO_FAIRNESS_HAUSDORFF else "the fewest folds of the weights tried).")
+                         if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=3)
+    if measure and len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
+        import warnings
+
+        warnings.warn(f"the geometry image of {name} stays {100 * distance['hausdorff']:.2g}% of the diagonal from the "
+                      f"mesh at n = {n}, the largest n='auto' tries (goal {100 * AUTO_HAUSDORFF:g}%): detail "
+                      "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=3)
+    stretch = dict(smap.stretch)
+    stretch["flipped"] = int(smap.flipped)
+    if sphere_map is None:
+        stretch["level_inverse"] = float(LEVEL_INVERSE if inverse is None else inverse)
+    report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
+                         stretch, distance, fit.rms, folded, got.orientation, tuple(repairs), folds)
+    return fit.image, report
+
+
+def _parametrize(mesh, name, progress, options, seconds):
+    """:func:`.sphere.spherical_parametrization` of ``mesh``, its seconds (and its stages') added to ``seconds``."""
+    from .sphere import spherical_parametrization
 
     t0 = time.perf_counter()
-    from .._reproducible import mat
-    from .image import image_uv, octahedral_to_sphere
+    smap = spherical_parametrization(mesh, name=name, progress=progress, **options)
+    seconds["parametrize"] = seconds.get("parametrize", 0.0) + time.perf_counter() - t0
+    for stage, s in smap.timings.items():
+        seconds[f"parametrize/{stage}"] = seconds.get(f"parametrize/{stage}", 0.0) + float(s)
+    return smap
 
+
+def _orientation(orientation, smap, seconds) -> np.ndarray:
+    """The rotation of the sphere under the octahedron (``orientation`` of :func:`geometry_image_from_mesh`) for
+    the map ``smap``; its seconds added to ``seconds["orient"]``."""
+    t0 = time.perf_counter()
     if isinstance(orientation, str) and orientation == "auto":
         from .orient import best_orientation
 
@@ -448,22 +555,39 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
         R = np.asarray(orientation, dtype=np.float64)
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0:
             raise ValueError(f"orientation must be 'auto', None or a 3x3 rotation matrix, got {orientation!r}.")
-    seconds["orient"] = time.perf_counter() - t0
+    seconds["orient"] = seconds.get("orient", 0.0) + time.perf_counter() - t0
+    return R
 
-    sizes = AUTO_SIZES if isinstance(n, str) and n == "auto" else (int(n),)
-    if isinstance(n, str) and n != "auto":
-        raise ValueError(f"n must be 'auto' or an odd sample count, got {n!r}.")
-    auto_fairness = isinstance(fairness, str)
-    if auto_fairness and fairness != "auto":
-        raise ValueError(f"fairness must be 'auto' or a number >= 0, got {fairness!r}.")
-    fairness = AUTO_FAIRNESS[0] if auto_fairness else float(fairness)
-    measure = measure or len(sizes) > 1 or auto_fairness
+
+@dataclass
+class _Built:
+    """One image made from one spherical map (:func:`_image_from_map`): the fit kept, its size and fairness, the
+    report's distance, the check's folds and the build's own fold share, and the sphere's rotation."""
+    fit: object
+    n: int
+    fairness: float
+    distance: dict
+    folds: dict
+    folded: float
+    orientation: np.ndarray
+
+
+def _image_from_map(smap, R, sizes, *, fairness, auto_fairness, oversample, measure, levels_finer, smoothing,
+                    turn_guard, vertices, seconds) -> _Built:
+    """Stages 3-5 of the module docstring on the spherical map ``smap`` rotated by ``R``: the first of ``sizes``
+    close enough to the mesh (:func:`_next_size`), then, with ``turn_guard="auto"`` and ``auto_fairness``, the
+    fits of :func:`geometry_image_from_mesh`'s ``turn_guard`` and ``fairness`` (the one least past the thresholds
+    kept). Stage seconds are added to ``seconds``."""
+    from .._reproducible import mat
+    from .image import image_uv, octahedral_to_sphere
+    from .sphere import locate
+
     tried = {}
     index = 0
     while index < len(sizes):
         n = sizes[index]
         t0 = time.perf_counter()
-        k = auto_oversample(n, info["vertices"]) if isinstance(oversample, str) and oversample == "auto" else oversample
+        k = auto_oversample(n, vertices) if isinstance(oversample, str) and oversample == "auto" else oversample
         M = int(k) * (int(n) - 1) + 1
         # the image's direction d samples the parametrization at R^T d: the sphere rotated by R under the octahedron
         face, bary = locate(smap, mat(octahedral_to_sphere(image_uv(M)).reshape(-1, 3), R))
@@ -546,34 +670,4 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
             folds["reversed_tried"] = reversed_tried
         if isinstance(turn_guard, str) and smoothing > 0:
             folds["turn_guard_tried"] = tried_g
-        if _badness(folds) > 1.0:
-            import warnings
-
-            warnings.warn(f"the geometry image of {name} folds over in {100 * folds['fraction']:.2g}% of its limit "
-                          f"triangles at level {FOLD_LEVEL} ({100 * folded:.2g}% at level {levels_finer}) and is "
-                          f"inside out at {100 * folds['reversed']:.2g}% of its limit points: the "
-                          f"spherical parametrization (stretch {smap.stretch.get('l2', float('nan')):.3g}, largest "
-                          f"{smap.stretch.get('l2_max', float('nan')):.3g}; anisotropy median "
-                          f"{smap.stretch.get('anisotropy_median', float('nan')):.3g}, 95th percentile "
-                          f"{smap.stretch.get('anisotropy_p95', float('nan')):.3g}) undersamples part of the mesh "
-                          "(the folds sit where a square of the sphere comes out longest one way on the mesh); "
-                          + _guard_words(folds.get("turn_guard_tried", {}))
-                          + ("fairness tried (folds, distance): " + ", ".join(
-                              f"{f:g}: " + ("folds not counted" if a != a else f"{100 * a:.2g}%") + f", {100 * b:.2g}%"
-                              for f, (a, b) in folds["fairness_tried"].items())
-                             + f"; kept {fairness:g} (" + (
-                                 f"a stronger one moves the surface more than {100 * AUTO_FAIRNESS_HAUSDORFF:g}% of "
-                                 "the diagonal from the mesh)." if list(folds["fairness_tried"].values())[-1][1]
-                                 > AUTO_FAIRNESS_HAUSDORFF else "the fewest folds of the weights tried).")
-                             if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=3)
-        if len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
-            import warnings
-
-            warnings.warn(f"the geometry image of {name} stays {100 * distance['hausdorff']:.2g}% of the diagonal from the "
-                          f"mesh at n = {n}, the largest n='auto' tries (goal {100 * AUTO_HAUSDORFF:g}%): detail "
-                          "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=3)
-    stretch = dict(smap.stretch)
-    stretch["flipped"] = int(smap.flipped)
-    report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
-                         stretch, distance, fit.rms, folded, R, tuple(repairs), folds)
-    return fit.image, report
+    return _Built(fit, int(n), float(fairness), distance, folds, folded, R)
