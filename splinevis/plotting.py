@@ -424,9 +424,8 @@ class Plotter(pv.Plotter):
 
         ``surface`` is a :class:`~splinevis.geometry_image.GeometryImage`, or a closed genus-0 triangle mesh (pyvista
         PolyData or any file pyvista reads), parametrized on the sphere and fitted with an ``n x n`` image
-        (``n="auto"``: the smallest of 33, 65, 129, 257 within 0.5 % of the diagonal of the mesh, measured, and one
-        twice as fine, up to 513, from a parametrization nearer conformal where that image folds; warnings of folds
-        and of detail it cannot resolve reach the caller) with ``fairness`` ("auto": 0.1, stronger while the
+        (``n="auto"``: the smallest of 33, 65, 129, 257 within 0.5 % of the diagonal, measured, or, where it folds,
+        one twice as fine from a map nearer conformal; warnings of folds and lost detail reach the caller) with ``fairness`` ("auto": 0.1, stronger while the
         surface folds, :func:`splinevis.geometry_image.build.geometry_image_from_mesh`) first (a mesh that is not
         closed, manifold, connected and of genus 0 raises :class:`splinevis.errors.MeshTopologyError` saying which
         check failed and where). ``displacement``: a scalar map on the output grid

@@ -39,7 +39,7 @@ from .detect import collect_files, companion_files, detect_family
 __all__ = ["check", "FILE_TIMEOUT"]
 
 #: Seconds one file may take before it is judged FAIL (a reader that never returns). 2400: a scan whose geometry
-#: image folds is built twice, the second time at 513 x 513 (``geometry_image.build.ESCALATE_INVERSE``), and
+#: image folds is built twice, the second time at 513 x 513 (``geometry_image.auto.ESCALATE_INVERSE``), and
 #: measured on the 134 million limit triangles of that image's level 4: beast.obj (65k triangles) took 1105 s
 #: with armadillo.obj judged beside it (build 495 s, measures 568 s), and armadillo.obj more than 1200 s.
 FILE_TIMEOUT = 2400.0

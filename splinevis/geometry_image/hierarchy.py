@@ -76,7 +76,7 @@ FULL_WORK = 250_000
 #: 0.0023 % / 0.061 % / 0.42 %; 1: 0.0022 % / 0.15 % / 0.63 % (L2 stretch 1.21 -> 1.28, anisotropy median 1.41 ->
 #: 1.56): past the check's inside-out threshold. ``parametrization_options={"level_inverse": 1.0}`` of
 #: :func:`.build.geometry_image_from_mesh` turns it on; its ``n="auto"`` turns it on by itself, with an image twice
-#: as fine, where the image of the plain map still folds (:data:`.build.ESCALATE_INVERSE`).
+#: as fine, where the image of the plain map still folds (:data:`.auto.ESCALATE_INVERSE`).
 LEVEL_INVERSE = 0.0
 
 #: Steps of :func:`_settle_inserted` after each round's insertion.
