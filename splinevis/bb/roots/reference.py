@@ -26,6 +26,19 @@ def _f64(c, x):
     return f
 
 
+def _bisect(c, lo, hi, flo, steps: int):
+    """Midpoints of the brackets ``[lo, hi]`` (one per row of ``c``, ``flo`` the value at ``lo``, the sign
+    changing inside) after ``steps`` float64 bisections."""
+    cc = np.asfortranarray(c)  # see _f64
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        fm = _f64(cc, mid[:, None])[:, 0]
+        same = np.signbit(fm) == np.signbit(flo)
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+    return 0.5 * (lo + hi)
+
+
 def _to_power(c):
     """BB -> power form: f(t) = sum_j p_j t^j, p_j = C(n,j) sum_{k<=j} (-1)^(j-k) C(j,k) c_k."""
     n = c.shape[-1] - 1
@@ -68,15 +81,7 @@ def _isolated_roots(flat: np.ndarray) -> np.ndarray:
     # bisect only the brackets that are kept; often there is none (a third of the calls of a terrain walk)
     r_idx, k_idx = np.nonzero(change)
     if r_idx.size:
-        lo, hi, flo = a0[r_idx, k_idx], b0[r_idx, k_idx], fa[r_idx, k_idx]
-        cc = np.asfortranarray(flat[r_idx])
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            fm = _f64(cc, mid[:, None])[:, 0]
-            same = np.signbit(fm) == np.signbit(flo)
-            lo = np.where(same, mid, lo)
-            hi = np.where(same, hi, mid)
-        found[r_idx, k_idx] = 0.5 * (lo + hi)
+        found[r_idx, k_idx] = _bisect(flat[r_idx], a0[r_idx, k_idx], b0[r_idx, k_idx], fa[r_idx, k_idx], 60)
     f1, _ = _eval_deriv(c3, np.ones((m, 1)), np.float64)
     S1, _ = _eval_deriv(np.abs(c3), np.ones((m, 1)), np.float64)
     end = np.where(np.abs(f1[:, 0]) <= 8 * n * np.finfo(np.float64).eps * S1[:, 0], 1.0, np.nan)
@@ -161,17 +166,7 @@ def roots_reference(c) -> np.ndarray:
         r_idx, i_idx = np.nonzero(change)
         bis = np.full((m, _SCAN), np.nan)
         if r_idx.size:
-            lo = grid[i_idx].copy()
-            hi = grid[i_idx + 1].copy()
-            flo = fg[r_idx, i_idx]
-            cc = np.asfortranarray(flat[r_idx])
-            for _ in range(52):
-                mid = 0.5 * (lo + hi)
-                fm = _f64(cc, mid[:, None])[:, 0]
-                same = np.signbit(fm) == np.signbit(flo)
-                lo = np.where(same, mid, lo)
-                hi = np.where(same, hi, mid)
-            bis[r_idx, i_idx] = 0.5 * (lo + hi)
+            bis[r_idx, i_idx] = _bisect(flat[r_idx], grid[i_idx], grid[i_idx + 1], fg[r_idx, i_idx], 52)
         cands.append(bis)
         # polish the eigenvalue candidates with guarded float64 Newton steps (a step must lower |f|)
         xe = np.clip(eig_c, 0.0, 1.0)
