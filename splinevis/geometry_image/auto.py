@@ -58,7 +58,8 @@ AUTO_FAIRNESS_HAUSDORFF = 0.01
 #: the turn guard and fairness were tried: it parametrizes the mesh again with the inverse map's stretch in the
 #: coarse levels' relaxations (``level_inverse`` = :data:`ESCALATE_INVERSE`, :data:`.hierarchy.LEVEL_INVERSE`'s
 #: comment says why that keeps the coarse levels nearer conformal) and builds an image twice as fine (at most
-#: :data:`ESCALATE_MAX` samples per side); the image less past the thresholds is kept, if it is no farther from
+#: :data:`ESCALATE_MAX` samples per side; a map from the Tutte start, which the weight does not change, is reused
+#: for it); the image less past the thresholds is kept, if it is no farther from
 #: the mesh than ``max(AUTO_FAIRNESS_HAUSDORFF, the first's distance)`` (:func:`_prefer`; ``folds[
 #: "escalation_tried"]`` has both). Why both at once: at n = 257 the thin limbs of the four-legged scan cannot be
 #: sampled evenly and densely at once. Measured (folds at level 4 / inside out / Hausdorff, what the build kept):

@@ -52,7 +52,7 @@ class BuildReport:
     stretch : dict
         The spherical parametrization's stretch (:class:`.sphere.SphericalMap`), ``"flipped"`` its flipped
         triangles and, when the build parametrized the mesh itself, ``"level_inverse"`` the inverse-stretch weight
-        of the map kept (:data:`ESCALATE_INVERSE` if the finer image was kept).
+        of the map kept (:data:`ESCALATE_INVERSE` if the finer image from a second coarse-to-fine map was kept).
     distance : dict
         :func:`.measure.surface_distance` of the fitted surface to the mesh (``hausdorff``, ``rms``, ...), in
         units of the mesh's bounding-box diagonal; empty when not measured.
@@ -198,17 +198,22 @@ def _fold_measure(image, n: int) -> dict:
             "at_cut": at_cut}
 
 
-def _measured(image, n: int, levels_finer: int, smap) -> tuple:
-    """``(distance, folds, folded)`` of a fitted ``image`` against the mesh of ``smap``: the report's distance
-    (:func:`.measure.surface_distance` on level ``levels_finer``), the check's folds with the inside-out share
-    (:func:`_fold_measure`, :func:`.measure.reversed_normals`) and the build's own fold share
+def _near(image, levels_finer: int, smap) -> tuple:
+    """``(distance, reversed, folded)`` of a fitted ``image`` against the mesh of ``smap``, all on the limit mesh
+    ``levels_finer`` levels down: the report's distance (:func:`.measure.surface_distance`), the share of limit
+    points that are inside out (:func:`.measure.reversed_normals`) and the build's own fold share
     (:func:`folded_fraction`)."""
     P, N, F = limit_mesh_arrays(image, levels_finer)
     distance = surface_distance(P, F, smap.points, smap.faces, closest=True)
     reversed_ = reversed_normals(N, distance.pop("closest_face"), smap.points, smap.faces)
-    folded = folded_fraction(P, N, F)
-    del P, N, F
-    return distance, dict(_fold_measure(image, n), reversed=reversed_["reversed_fraction"]), folded
+    return distance, reversed_["reversed_fraction"], folded_fraction(P, N, F)
+
+
+def _measured(image, n: int, levels_finer: int, smap) -> tuple:
+    """``(distance, folds, folded)`` of a fitted ``image``: :func:`_near`, the inside-out share put with the check's
+    folds (:func:`_fold_measure`)."""
+    distance, reversed_, folded = _near(image, levels_finer, smap)
+    return distance, dict(_fold_measure(image, n), reversed=reversed_), folded
 
 
 def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="auto",
@@ -226,8 +231,8 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         the first of :data:`AUTO_SIZES` whose limit surface is within :data:`AUTO_HAUSDORFF` of the diagonal of
         the mesh (measured; ``distance["sizes_tried"]`` lists each size's distance), with a warning when the
         largest is not; an image that still folds is built again, twice as fine, from a parametrization nearer
-        conformal (:data:`ESCALATE_INVERSE`; not when ``sphere_map`` or ``parametrization_options["level_inverse"]``
-        is given).
+        conformal (:data:`ESCALATE_INVERSE`; from the same map where it came from the Tutte start, which the weight
+        does not change; not when ``sphere_map`` or ``parametrization_options["level_inverse"]`` is given).
     fairness : float or "auto"
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
         leaves in the normals (measured in the geometry-image study) at a small cost in distance. ``"auto"``
@@ -339,15 +344,20 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     inverse = (parametrization_options or {}).get("level_inverse")
     if len(sizes) > 1 and sphere_map is None and inverse is None and got.n < ESCALATE_MAX and _badness(got.folds) > 1:
         n2 = min(2 * (got.n - 1) + 1, ESCALATE_MAX)
-        smap2 = _parametrize(mesh, name, progress, dict(parametrization_options or {}, level_inverse=ESCALATE_INVERSE),
-                             seconds)
-        got2 = _image_from_map(smap2, _orientation(orientation, smap2, seconds), (n2,), **settings)
+        # the inverse weight acts on the coarse-to-fine start's levels only: a Tutte start would come out the same
+        inverse2 = ESCALATE_INVERSE if smap.start.startswith("coarse to fine") else LEVEL_INVERSE
+        smap2, R2 = smap, got.orientation
+        if inverse2 != LEVEL_INVERSE:
+            smap2 = _parametrize(mesh, name, progress, dict(parametrization_options or {}, level_inverse=inverse2),
+                                 seconds)
+            R2 = _orientation(orientation, smap2, seconds)
+        got2 = _image_from_map(smap2, R2, (n2,), **settings)
         got2.distance["sizes_tried"] = {**got.distance.get("sizes_tried", {}), n2: float(got2.distance["hausdorff"])}
         tried_e = {f"n = {k.n}, level_inverse {w:g}": (k.folds["fraction"], k.folds["reversed"],
                                                        float(k.distance["hausdorff"]))
-                   for k, w in ((got, LEVEL_INVERSE), (got2, ESCALATE_INVERSE))}
+                   for k, w in ((got, LEVEL_INVERSE), (got2, inverse2))}
         if _prefer(got2.folds, got2.distance["hausdorff"], got.folds, got.distance["hausdorff"]):
-            got, smap, inverse = got2, smap2, ESCALATE_INVERSE
+            got, smap, inverse = got2, smap2, inverse2
         got.folds["escalation_tried"] = tried_e
     fit, n, fairness, distance, folds, folded = got.fit, got.n, got.fairness, got.distance, got.folds, got.folded
     if measure and _badness(folds) > 1.0:
@@ -464,10 +474,7 @@ def _image_from_map(smap, R, sizes, *, fairness, auto_fairness, oversample, meas
         distance, folded = {}, float("nan")
         if measure:
             t0 = time.perf_counter()
-            P, N, F = limit_mesh_arrays(fit.image, levels_finer)
-            distance = surface_distance(P, F, smap.points, smap.faces, closest=True)
-            reversed_ = reversed_normals(N, distance.pop("closest_face"), smap.points, smap.faces)
-            folded = folded_fraction(P, N, F)
+            distance, reversed_, folded = _near(fit.image, levels_finer, smap)
             seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
             tried[int(n)] = float(distance["hausdorff"])
             if distance["hausdorff"] <= AUTO_HAUSDORFF:
@@ -478,7 +485,7 @@ def _image_from_map(smap, R, sizes, *, fairness, auto_fairness, oversample, meas
     folds = {}
     if measure:
         t0 = time.perf_counter()
-        folds = dict(_fold_measure(fit.image, n), reversed=reversed_["reversed_fraction"])
+        folds = dict(_fold_measure(fit.image, n), reversed=reversed_)
         seconds["measure"] = seconds.get("measure", 0.0) + time.perf_counter() - t0
         if isinstance(turn_guard, str) and smoothing > 0:
             tried_g = {"turn guard": (folds["fraction"], folds["reversed"], float(distance["hausdorff"]))}
