@@ -60,3 +60,33 @@ def test_tiled_measures_equal_the_whole_levels(crumple, cells):
     assert got["rms"] == pytest.approx(want["rms"], rel=1e-12)
     if crumple:
         assert got["folded_triangles"] > 0 and got["reversed_points"] > 0 and got["cut_vertex_folded"] > 0
+
+
+@pytest.mark.parametrize("reach", [0.05, 1e-4])
+def test_pruned_distances_from_the_mesh_equal_those_to_the_whole_level(reach):
+    """Every input sample's distance to the limit triangles (the check's 'from the reference' direction), searched
+    tile by tile among the blocks that can hold the nearest triangle (judge._from_reference), equals libigl's over
+    all the level's triangles at once; with a reach of 1e-4 of the diagonal most samples take the fallback (every
+    triangle of every tile) and still agree."""
+    import igl
+
+    from splinevis.geometry_image import judge
+
+    blob = star_blob(level=2)
+    rng = np.random.default_rng(5)
+    model = model_from(blob, 17, fairness=0.1)
+    model = GeometryImage(symmetrize(model.control + 0.3 * rng.normal(size=model.control.shape)), constrain=True)
+    V = np.asarray(blob.points, dtype=np.float64)
+    F = np.asarray(blob.faces).reshape(-1, 4)[:, 1:].astype(np.int64)
+    samples = np.vstack([V, V[F].mean(axis=1)])
+    L, cells = 3, 3
+    P, _, T = limit_mesh_arrays(model, L)
+    M = int(round(np.sqrt(len(P))))
+    want = igl.point_mesh_squared_distance(samples, P, T)[0]
+    diagonal = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    reach2 = (reach * diagonal) ** 2
+    corners = P.reshape(M, M, 3)[::2, ::2].reshape(-1, 3)
+    got = judge._from_reference(samples, corners, model.control, L, cells, reach2)
+    np.testing.assert_array_equal(got, want)
+    if reach < 1e-3:
+        assert (want > reach2).mean() > 0.5  # the fallback measured most of them
