@@ -1,6 +1,8 @@
 """Test ordering only: the slowest tests (measured with ``--durations``, 10-45 s each on this machine) are moved to
-the front of the collection, so that with ``pytest -n 2 --dist worksteal`` the two workers start on them and the
-run does not end waiting on one long test started last. Every test stays independent of the order."""
+the front of the collection, so that with ``pytest -n 2 --dist loadfile`` (``tools/dev.sh test``: each file whole
+to one worker, files in the order of their first test) the two workers start on the slowest files (the GPU hard
+cases, about 5 minutes of one core, first) and the run does not end waiting on one long file started last. Every
+test stays independent of the order."""
 
 #: Node-id prefixes of the slowest tests (``pytest --durations=30``, 2026-12-07).
 SLOW_FIRST = (
