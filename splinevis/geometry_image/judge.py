@@ -305,7 +305,7 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     """Lower ``best`` (squared distances of ``samples`` to the limit triangles, the least libigl found so far) to
     the least over the triangles of one tile, ``points`` ``(k, k, 3)`` (:func:`.subdivision.grid_faces`'s
     triangles), wherever that is within ``r = min(bound, sqrt(best), reach) + slack`` (``bound``: at least the
-    distance to the nearest triangle, :func:`_from_reference`); return the number of triangles searched.
+    distance to the nearest triangle, :func:`_from_reference`).
 
     Exact, with a fraction of the tile's triangles: a triangle within ``r`` lies in a block of
     :data:`PRUNE_CELLS` x :data:`PRUNE_CELLS` cells whose bounding box is within ``r``. Only samples whose
@@ -327,7 +327,7 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     radius = np.minimum(np.minimum(bound, np.sqrt(best)), reach) + slack
     cand = np.flatnonzero(_box_distance2(samples, lo, hi) <= radius * radius)
     if not cand.size:
-        return 0
+        return
     q = samples[cand]
     r = radius[cand]
     # the cells' boxes, then those of blocks of PRUNE_CELLS x PRUNE_CELLS cells (the last ones may be smaller)
@@ -353,7 +353,7 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     near = _box_distance2(q[owner], blo[block], bhi[block]) <= r[owner] * r[owner]
     chosen = np.unique(block[near])
     if not chosen.size:
-        return 0
+        return
     # the cells of the chosen blocks, then their two triangles each
     rows = (np.divmod(chosen, nb)[0] * b)[:, None, None] + np.arange(b)[None, :, None]
     cols = (np.divmod(chosen, nb)[1] * b)[:, None, None] + np.arange(b)[None, None, :]
@@ -363,7 +363,6 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     faces = grid_faces(k)[np.stack([2 * cells, 2 * cells + 1], axis=1).ravel()]
     d2 = igl.point_mesh_squared_distance(np.ascontiguousarray(q), flat, faces)[0]
     best[cand] = np.minimum(best[cand], d2)
-    return len(faces)
 
 
 def _pixels(fraction: float) -> str:
