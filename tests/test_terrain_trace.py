@@ -84,3 +84,19 @@ def test_block_mesh_of_a_large_grid_lies_above_within_its_exit_bound(scheme, mon
     i = np.minimum(uv[:, 0].astype(int), ncx - 1)
     j = np.minimum(uv[:, 1].astype(int), ncy - 1)
     assert (above > 0).all() and (above <= G[j, i] * (1 + 1e-9)).all()
+
+
+@pytest.mark.parametrize("kind", ["crater", "cliff"])
+def test_the_reference_solves_in_batches_the_same_hits_as_step_by_step(kind, monkeypatch):
+    # raycast_terrain solves the candidate segments of several walk steps at once; each ray keeps its first
+    # candidate with a root in the walk's order, so the hits equal those of solving every step alone, bit for bit
+    from splinevis.terrain import raycast
+
+    t = TerrainSpline.from_heights(high_relief(kind, 33), "C2", spacing=(1.0, 1.0))
+    o, d = _rays(t, 30000, 3)
+    batched = raycast_terrain(t, o, d)
+    monkeypatch.setattr(raycast, "FLUSH_STEPS", 1)
+    single = raycast_terrain(t, o, d)
+    assert np.isfinite(batched.t).sum() > 500
+    assert np.array_equal(batched.t, single.t, equal_nan=True)
+    assert np.array_equal(batched.normals, single.normals, equal_nan=True)

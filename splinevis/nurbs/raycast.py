@@ -12,6 +12,8 @@ interpolated parameters by Newton on the pixel's ray written as two planes [Kana
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ..gl.contract import RayHits
@@ -246,6 +248,43 @@ def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
     return t_out, pid_out, uv_out
 
 
+class _LastHits:
+    """The patch and (u, v) of each hit of the last reference cast, found again by the ray's exact origin,
+    direction and t: :func:`depth_bound` needs them at the hits the reference just found (the comparison of a
+    render with the reference calls both on the same rays), and casting again cost as much as the cast."""
+
+    def __init__(self):
+        self.model, self.index, self.pid, self.uv = None, {}, None, None
+
+    @staticmethod
+    def _keys(o, d, t):
+        rows = np.ascontiguousarray(np.concatenate([o, d, t[:, None]], axis=1))
+        return [r.tobytes() for r in rows]
+
+    def store(self, model, o, d, t, pid, uv):
+        hit = np.flatnonzero(np.isfinite(t))
+        try:
+            self.model = weakref.ref(model)
+        except TypeError:  # not weakly referable: nothing is kept
+            self.model = None
+            return
+        self.index = dict(zip(self._keys(o[hit], d[hit], t[hit]), hit))
+        self.pid, self.uv = pid, uv
+
+    def find(self, model, o, d, t):
+        """(pid, uv) of every ray found in the last cast of ``model`` (pid -1 where not found)."""
+        pid, uv = np.full(len(o), -1), np.full((len(o), 2), np.nan)
+        if self.model is None or self.model() is not model or not len(o):
+            return pid, uv
+        at = np.array([self.index.get(k, -1) for k in self._keys(o, d, t)], dtype=np.int64)
+        found = at >= 0
+        pid[found], uv[found] = self.pid[at[found]], self.uv[at[found]]
+        return pid, uv
+
+
+_LAST = _LastHits()
+
+
 def reference(model, origins, directions, tmin=0.0, *, method="reference", iterations=None):
     """Float64 ray cast of a NURBS model (world rays of any leading shape): :class:`RayHits`.
 
@@ -267,6 +306,7 @@ def reference(model, origins, directions, tmin=0.0, *, method="reference", itera
     shape = o.shape[:-1]
     if method == "reference":
         t, pid, uv = _cast(m, o, d, tmin, 40, 8, False)
+        _LAST.store(model, o.reshape(-1, 3), d.reshape(-1, 3), t, pid, uv)
     elif method == "newton":
         t, pid, uv = _cast(m, o, d, tmin, 12 if iterations is None else iterations, 8, True)
     else:
@@ -333,7 +373,13 @@ def depth_bound(model, matrix, origins, directions, t):
     o = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
     d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
     t = np.asarray(t, dtype=np.float64).ravel()
-    _, pid, uv = _cast(m, o + (t - 1e-3 * np.abs(t) - 1e-9)[:, None] * d, d, 0.0, 40, 8, False)
+    # the patch and (u, v) of each hit: those of the reference cast that found it, else cast again from just
+    # before the hit (the first root after that start is the hit)
+    pid, uv = _LAST.find(model, o, d, t)
+    again = np.flatnonzero(pid < 0)
+    if again.size:
+        oa, da, ta = o[again], d[again], t[again]
+        _, pid[again], uv[again] = _cast(m, oa + (ta - 1e-3 * np.abs(ta) - 1e-9)[:, None] * da, da, 0.0, 40, 8, False)
     pts = tessellate(m)[0]
     E = float(np.linalg.norm(pts, axis=-1).max())
     rd = d / np.linalg.norm(d, axis=-1, keepdims=True)

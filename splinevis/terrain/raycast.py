@@ -21,6 +21,10 @@ from .model import TerrainSpline, cell_barycentric
 
 __all__ = ["raycast_terrain", "first_hit_in_cell"]
 
+#: A batch of candidate segments is solved when it has this many rows or spans this many walk steps.
+FLUSH_ROWS = 20_000
+FLUSH_STEPS = 16
+
 
 def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="reference", iterations=8):
     """First t in [ta, tb] where the ray meets the cell's spline, else NaN. All arrays (N,); coef (N, 2, 15).
@@ -118,6 +122,24 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
     step_j = np.where(dV > 0, 1, -1)
     cell_lo, cell_hi = terrain.hierarchy.levels[0]
     steps = max_steps if max_steps is not None else 2 * (ncx + ncy) + 4
+    # The candidate segments (ray, cell, ta, tb) of several steps are solved in one batch: the root finder's
+    # cost is numpy's per-call overhead on the few hundred rows one step has. A ray walks on after its
+    # candidates until the batch is solved (at most FLUSH_STEPS steps), then stops at its first candidate with
+    # a root: in the walk's order, so the hits are those of solving every step at once, bit for bit.
+    pending = []  # per step: (rays, cells i, cells j, ta, tb)
+    pending_rows = 0
+    since_flush = 0
+
+    def flush():
+        rays, ii, jj, ta, tb = (np.concatenate(a) for a in zip(*pending))
+        th = first_hit_in_cell(terrain.coefficients[jj, ii], U0[rays] - ii, V0[rays] - jj, Z0[rays], dU[rays],
+                               dV[rays], dZ[rays], ta, tb, method=method, iterations=iterations)
+        found = np.nonzero(np.isfinite(th))[0]
+        first = found[np.unique(rays[found], return_index=True)[1]]  # each ray's earliest candidate with a root
+        t_hit[rays[first]] = th[first]
+        active[rays[first]] = False
+        pending.clear()
+
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(steps):
             idx = np.nonzero(active)[0]
@@ -134,23 +156,21 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
             rlo, rhi = np.minimum(za, zb), np.maximum(za, zb)
             overlap = (rhi >= cell_lo[j, i]) & (rlo <= cell_hi[j, i])
             if overlap.any():
-                k = idx[overlap]
-                ii, jj = ci[k], cj[k]
-                th = first_hit_in_cell(terrain.coefficients[jj, ii], U0[k] - ii, V0[k] - jj, Z0[k], dU[k], dV[k], dZ[k],
-                                       tm[k], tb[overlap], method=method, iterations=iterations)
-                found = np.isfinite(th)
-                t_hit[k[found]] = th[found]
-                active[k[found]] = False
-            # advance the rays still active
-            adv = active[idx]
-            idx2 = idx[adv]
-            tb2 = tb[adv]
-            go_u = txu[adv] <= txv[adv]
-            tm[idx2] = tb2
-            ci[idx2] += np.where(go_u, step_i[idx2], 0)
-            cj[idx2] += np.where(go_u, 0, step_j[idx2])
-            done = (tb2 >= t1[idx2]) | (ci[idx2] < 0) | (ci[idx2] >= ncx) | (cj[idx2] < 0) | (cj[idx2] >= ncy)
-            active[idx2[done]] = False
+                pending.append((idx[overlap], i[overlap], j[overlap], ta[overlap], tb[overlap]))
+                pending_rows += int(overlap.sum())
+            # advance every ray still walking
+            go_u = txu <= txv
+            tm[idx] = tb
+            ci[idx] += np.where(go_u, step_i[idx], 0)
+            cj[idx] += np.where(go_u, 0, step_j[idx])
+            done = (tb >= t1[idx]) | (ci[idx] < 0) | (ci[idx] >= ncx) | (cj[idx] < 0) | (cj[idx] >= ncy)
+            active[idx[done]] = False
+            since_flush += 1
+            if pending and (pending_rows >= FLUSH_ROWS or since_flush >= FLUSH_STEPS):
+                flush()
+                pending_rows = since_flush = 0
+        if pending:
+            flush()
     t = t_hit.reshape(shape)
     pts = o.reshape(shape + (3,)) + t[..., None] * d.reshape(shape + (3,))
     normals = np.full(pts.shape, np.nan)
