@@ -112,7 +112,7 @@ def test_the_stretch_reported_is_sanders_and_finite(make):
     assert 1.0 - 1e-12 <= st["l2"] <= st["l2_start"]
     assert st["l2_max"] >= st["l2_p95"] and st["area_ratio_max"] >= st["area_ratio_p95"] >= 1.0
     assert set(smap.timings) == {"validate", "tutte", "mobius", "hierarchy", "relax", "check", "total"}
-    assert smap.start == "tutte" and smap.timings["hierarchy"] == 0.0
+    assert smap.start == "tutte" and smap.start_levels == 0 and smap.timings["hierarchy"] == 0.0
 
 
 def test_the_anisotropy_is_the_ratio_of_the_singular_values():

@@ -345,7 +345,7 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     if len(sizes) > 1 and sphere_map is None and inverse is None and got.n < ESCALATE_MAX and _badness(got.folds) > 1:
         n2 = min(2 * (got.n - 1) + 1, ESCALATE_MAX)
         # the inverse weight acts on the coarse-to-fine start's levels only: a Tutte start would come out the same
-        inverse2 = ESCALATE_INVERSE if smap.start.startswith("coarse to fine") else LEVEL_INVERSE
+        inverse2 = ESCALATE_INVERSE if smap.start == "coarse to fine" else LEVEL_INVERSE
         smap2, R2 = smap, got.orientation
         if inverse2 != LEVEL_INVERSE:
             smap2 = _parametrize(mesh, name, progress, dict(parametrization_options or {}, level_inverse=inverse2),

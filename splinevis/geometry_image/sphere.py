@@ -92,7 +92,9 @@ class SphericalMap:
     timings : dict
         Seconds per stage.
     start : str
-        Which one-to-one start the relaxation began from: ``"tutte"`` or ``"coarse to fine (<n> levels)"``.
+        Which one-to-one start the relaxation began from: ``"tutte"`` or ``"coarse to fine"``.
+    start_levels : int
+        The coarse-to-fine start's levels (rounds of collapses re-inserted); 0 for a Tutte start.
 
     The arrays are read-only.
 
@@ -111,6 +113,7 @@ class SphericalMap:
     flipped: int = 0
     timings: dict = field(default_factory=dict)
     start: str = "tutte"
+    start_levels: int = 0
 
 
 def _frozen(a, dtype):
@@ -201,7 +204,7 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     mass = igl.massmatrix(P, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
     timings["tutte"] = timings["mobius"] = timings["hierarchy"] = 0.0
     failure = f"{name}: no vertex has a chordless ring to cut the mesh open at."
-    X, method = None, "tutte"
+    X, method, levels = None, "tutte", 0
     S = StretchEnergy(P, F)
     for v in (_start_vertices(F, mass) if start != "hierarchy" else ()):  # the next one if not one-to-one
         t = time.perf_counter()
@@ -228,7 +231,7 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
             Y, info = hierarchical_sphere(P, F, progress=bool(progress), **(
                 {} if level_inverse is None else {"inverse": float(level_inverse)}))
             _check_one_to_one(Y, F, name, "the coarse-to-fine start")
-            X, method = Y, f"coarse to fine ({info['levels']} levels)"
+            X, method, levels = Y, "coarse to fine", int(info["levels"])
             l2_start = S.report(X)["l2"]
         except RuntimeError as err:
             if X is None:
@@ -246,7 +249,7 @@ def spherical_parametrization(mesh, *, name: str = "mesh", iterations: int = 200
     timings["total"] = time.perf_counter() - t0
     return SphericalMap(points=_frozen(P, np.float64), faces=_frozen(F, np.int64), sphere=_frozen(X, np.float64),
                         stretch=stretch, flipped=int((~(_det(X, F) > DET_BOUND)).sum()), timings=timings,
-                        start=method)
+                        start=method, start_levels=levels)
 
 
 def _check_one_to_one(X, F, name, what):
