@@ -73,6 +73,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._boxes import box_distance2
 from ..check.judge import FamilyJudge, Finding
 from .build import FOLDED_WARNING, REVERSED_WARNING
 
@@ -266,13 +267,6 @@ def surface_measures(model, mesh, measure_level: int, drawn_level: int | None = 
     return out
 
 
-def _box_distance2(q, lo, hi):
-    """Squared distances of the points ``q`` ``(K, 3)`` to the axis-aligned boxes ``[lo, hi]`` (one box, or one
-    per point)."""
-    d = np.maximum(np.maximum(lo - q, q - hi), 0.0)
-    return np.einsum("ij,ij->i", d, d)
-
-
 def _from_reference(samples, corners, control, level, cells, reach2):
     """Squared distances of the input mesh's ``samples`` to the limit triangles of ``control`` at ``level``,
     libigl's (``surface_measures``' other direction, measured in a second pass over the tiles): each sample is
@@ -325,7 +319,7 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     flat = points.reshape(-1, 3)
     lo, hi = flat.min(axis=0), flat.max(axis=0)
     radius = np.minimum(np.minimum(bound, np.sqrt(best)), reach) + slack
-    cand = np.flatnonzero(_box_distance2(samples, lo, hi) <= radius * radius)
+    cand = np.flatnonzero(box_distance2(samples, lo, hi) <= radius * radius)
     if not cand.size:
         return
     q = samples[cand]
@@ -350,7 +344,7 @@ def _nearest_in_tile(samples, best, bound, points, reach, slack):
     block = small[np.concatenate([np.asarray(h, dtype=np.int64) for h in hits])] if owner.size else owner
     owner = np.concatenate([owner, np.repeat(np.arange(len(q)), large.size)])
     block = np.concatenate([block, np.tile(large, len(q))])
-    near = _box_distance2(q[owner], blo[block], bhi[block]) <= r[owner] * r[owner]
+    near = box_distance2(q[owner], blo[block], bhi[block]) <= r[owner] * r[owner]
     chosen = np.unique(block[near])
     if not chosen.size:
         return

@@ -46,6 +46,7 @@ import math
 
 import numpy as np
 
+from ..._boxes import box_distance2
 from ...gl.error_bounds import U32
 from .bvh import back_facing, frustum_cull, frustum_planes
 
@@ -80,9 +81,7 @@ def projection_scale(view_proj, viewport_height, fov_y=None) -> tuple:
 
 def _box_distance(boxes, eye):
     """Distance from ``eye`` to each box (S, 6); 0 inside."""
-    lo, hi = boxes[:, 0::2], boxes[:, 1::2]
-    gap = np.maximum(np.maximum(lo - eye, eye - hi), 0.0)
-    return np.sqrt(np.einsum("ij,ij->i", gap, gap))
+    return np.sqrt(box_distance2(eye, boxes[:, 0::2], boxes[:, 1::2]))
 
 
 def select_levels(lod, eye, view_proj, viewport_height, pixel_error=1.0, cull_back: bool = True, fov_y=None, *,
