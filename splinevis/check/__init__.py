@@ -36,14 +36,18 @@ from pathlib import Path
 
 from .detect import collect_files, companion_files, detect_family
 
-__all__ = ["check", "FILE_TIMEOUT"]
+__all__ = ["check", "FILE_TIMEOUT", "FILE_TIMEOUT_DEFAULT"]
 
-#: Seconds one file may take before it is judged FAIL (a reader that never returns). 1800: a scan whose geometry
-#: image folds is built twice, the second time at 513 x 513 (``geometry_image.auto.ESCALATE_INVERSE``), and
-#: measured on the 134 million limit triangles of that image's level 4: armadillo.obj took 929 s with beast.obj
-#: judged beside it (build 635 s, measures 280 s; beast.obj 877 s), and 1177 s in the whole folder's check (CI's
-#: ``.ci/run``, with another measurement running on the same two cores).
-FILE_TIMEOUT = 1800.0
+#: Seconds one file of a family may take before it is judged FAIL (a reader that never returns): about ten times
+#: the family's slowest file in the whole data folder's check (CI's ``.ci/run``, two files at once on two cores), at least 600:
+#: NURBS 87 s, volumes 54 s, terrains 13 s. Meshes 1800: a scan whose geometry image folds is built twice, the
+#: second time at 513 x 513 (``geometry_image.auto.ESCALATE_INVERSE``), and measured on the 134 million limit
+#: triangles of that image's level 4: armadillo.obj took 929 s with beast.obj judged beside it (build 635 s,
+#: measures 280 s; beast.obj 877 s), and 1177 s in the whole folder's check (with another measurement running on
+#: the same two cores).
+FILE_TIMEOUT = {"mesh": 1800.0, "nurbs": 900.0, "volume": 600.0, "terrain": 600.0}
+#: A family not in :data:`FILE_TIMEOUT`.
+FILE_TIMEOUT_DEFAULT = 900.0
 
 
 def _plan(paths, family: str):
@@ -60,6 +64,17 @@ def _plan(paths, family: str):
             fam = family
         plan.append((f, fam, fmt))
     return plan
+
+
+def _timeout(family: str, timeout: float | None) -> float:
+    """Seconds a file of ``family`` may take: ``timeout`` if given, else the family's :data:`FILE_TIMEOUT`.
+
+    >>> _timeout("terrain", None), _timeout("mesh", None), _timeout("terrain", 5)
+    (600.0, 1800.0, 5.0)
+    """
+    if timeout is not None:
+        return float(timeout)
+    return FILE_TIMEOUT.get(family, FILE_TIMEOUT_DEFAULT)
 
 
 def _run_one(path: Path, family: str, out: Path, options: dict, timeout: float) -> dict:
@@ -88,7 +103,7 @@ def _run_one(path: Path, family: str, out: Path, options: dict, timeout: float) 
 
 
 def check(paths, out="out/check", *, family: str = "auto", isovalue: float | None = None, jobs: int = 2,
-          progress: bool = True, timeout: float = FILE_TIMEOUT, options: dict | None = None) -> dict:
+          progress: bool = True, timeout: float | None = None, options: dict | None = None) -> dict:
     """Judge every file under ``paths`` and write the report to ``out`` (module docstring).
 
     Parameters
@@ -105,8 +120,8 @@ def check(paths, out="out/check", *, family: str = "auto", isovalue: float | Non
         Files judged at once (one process each).
     progress : bool
         A progress bar on stderr.
-    timeout : float
-        Seconds a file may take.
+    timeout : float, optional
+        Seconds a file may take (default: its family's, :data:`FILE_TIMEOUT`).
     options : dict, optional
         Passed to every family judge (e.g. ``{"scalars": "density"}``).
 
@@ -148,7 +163,7 @@ def check(paths, out="out/check", *, family: str = "auto", isovalue: float | Non
                           "findings": [{"level": "PASS", "reason": f"not judged: {why}"}]}
     with ThreadPoolExecutor(max_workers=jobs) as pool, tqdm(total=len(todo), disable=not progress, desc="check",
                                                              unit="file") as bar:
-        futures = {pool.submit(_run_one, p, fam, out, opts, timeout): p for p, fam in todo}
+        futures = {pool.submit(_run_one, p, fam, out, opts, _timeout(fam, timeout)): p for p, fam in todo}
         for fut in as_completed(futures):
             p = futures[fut]
             results[p] = fut.result()
