@@ -165,3 +165,36 @@ def test_a_tutte_started_map_is_reused_for_the_finer_image(monkeypatch):
     assert list(report.folds["escalation_tried"]) == ["n = 17, level_inverse 0", "n = 33, level_inverse 0"]
     assert report.n == 33 and report.stretch["level_inverse"] == 0.0
     np.testing.assert_array_equal(image.control, direct.control)
+
+
+def test_the_escalation_doubles_the_size_while_the_last_image_still_folds(monkeypatch):
+    # The Tutte-started legged blob (level 3) with the sizes scaled down (5, 9, then at most 33): its 9 x 9 image
+    # folds, and so does the 17 x 17 one (measured 0.16 % / 2.5 %), so the build goes on to 33 x 33 (0.024 % /
+    # 0.16 %): every image tried is listed, the least past the thresholds is kept, and it is exactly the image
+    # asked for directly.
+    import splinevis.geometry_image.build as build
+
+    monkeypatch.setattr(build, "AUTO_SIZES", (5, 9))
+    monkeypatch.setattr(build, "ESCALATE_MAX", 33)
+    mesh = cm.legged_blob(level=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        image, report = geometry_image_from_mesh(mesh, name="legs")
+        direct, _ = geometry_image_from_mesh(mesh, report.n, name="legs")
+    tried = report.folds["escalation_tried"]
+    assert list(tried) == ["n = 9, level_inverse 0", "n = 17, level_inverse 0", "n = 33, level_inverse 0"]
+    badness = {k: max(f / build.FOLDED_WARNING, r / build.REVERSED_WARNING) for k, (f, r, _) in tried.items()}
+    assert badness["n = 9, level_inverse 0"] > 1.0 and badness["n = 17, level_inverse 0"] > 1.0  # both went on
+    assert list(report.distance["sizes_tried"])[-2:] == [17, 33]
+    kept = f"n = {report.n}, level_inverse 0"
+    assert tried[kept] == (report.folds["fraction"], report.folds["reversed"], report.distance["hausdorff"])
+    np.testing.assert_array_equal(image.control, direct.control)
+
+
+def test_the_distance_warning_names_the_fairness_that_moved_the_surface():
+    from splinevis.geometry_image.build import _distance_words
+
+    kept_against_folds = _distance_words("m", 129, 3.0, 0.0051, {0.1: (4e-6, 0.0011), 3.0: (1e-6, 0.0051)})
+    assert "fairness 3, kept against its folds" in kept_against_folds and "0.11%" in kept_against_folds
+    resolution = _distance_words("m", 257, 0.1, 0.0093, {0.1: (1e-3, 0.0093)})
+    assert "detail finer than the image resolves" in resolution

@@ -230,8 +230,8 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         Samples per side, odd; ``2^k + 1`` for levels of detail down to the octahedron. ``"auto"`` (default):
         the first of :data:`AUTO_SIZES` whose limit surface is within :data:`AUTO_HAUSDORFF` of the diagonal of
         the mesh (measured; ``distance["sizes_tried"]`` lists each size's distance), with a warning when the
-        largest is not; an image that still folds is built again, twice as fine, from a parametrization nearer
-        conformal (:data:`ESCALATE_INVERSE`; from the same map where it came from the Tutte start, which the weight
+        largest is not; an image that still folds is built again, twice as fine (and again while the last one
+        still folds, up to :data:`ESCALATE_MAX`), from a parametrization nearer conformal (:data:`ESCALATE_INVERSE`; from the same map where it came from the Tutte start, which the weight
         does not change; not when ``sphere_map`` or ``parametrization_options["level_inverse"]`` is given).
     fairness : float or "auto"
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
@@ -343,7 +343,6 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     got = _image_from_map(smap, R, sizes, **settings)
     inverse = (parametrization_options or {}).get("level_inverse")
     if len(sizes) > 1 and sphere_map is None and inverse is None and got.n < ESCALATE_MAX and _badness(got.folds) > 1:
-        n2 = min(2 * (got.n - 1) + 1, ESCALATE_MAX)
         # the inverse weight acts on the coarse-to-fine start's levels only: a Tutte start would come out the same
         inverse2 = ESCALATE_INVERSE if smap.start == "coarse to fine" else LEVEL_INVERSE
         smap2, R2 = smap, got.orientation
@@ -351,13 +350,17 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
             smap2 = _parametrize(mesh, name, progress, dict(parametrization_options or {}, level_inverse=inverse2),
                                  seconds)
             R2 = _orientation(orientation, smap2, seconds)
-        got2 = _image_from_map(smap2, R2, (n2,), **settings)
-        got2.distance["sizes_tried"] = {**got.distance.get("sizes_tried", {}), n2: float(got2.distance["hausdorff"])}
-        tried_e = {f"n = {k.n}, level_inverse {w:g}": (k.folds["fraction"], k.folds["reversed"],
-                                                       float(k.distance["hausdorff"]))
-                   for k, w in ((got, LEVEL_INVERSE), (got2, inverse2))}
-        if _prefer(got2.folds, got2.distance["hausdorff"], got.folds, got.distance["hausdorff"]):
-            got, smap, inverse = got2, smap2, inverse2
+        tried_e = {f"n = {got.n}, level_inverse {LEVEL_INVERSE:g}": _escalation_entry(got)}
+        sizes_tried = dict(got.distance.get("sizes_tried", {}))
+        last = got
+        while last.n < ESCALATE_MAX and _badness(last.folds) > 1:  # twice as fine while the last one still folds
+            n2 = min(2 * (last.n - 1) + 1, ESCALATE_MAX)
+            last = _image_from_map(smap2, R2, (n2,), **settings)
+            sizes_tried[n2] = float(last.distance["hausdorff"])
+            last.distance["sizes_tried"] = dict(sizes_tried)
+            tried_e[f"n = {n2}, level_inverse {inverse2:g}"] = _escalation_entry(last)
+            if _prefer(last.folds, last.distance["hausdorff"], got.folds, got.distance["hausdorff"]):
+                got, smap, inverse = last, smap2, inverse2
         got.folds["escalation_tried"] = tried_e
     fit, n, fairness, distance, folds, folded = got.fit, got.n, got.fairness, got.distance, got.folds, got.folded
     if measure and _badness(folds) > 1.0:
@@ -384,9 +387,8 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     if measure and len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
         import warnings
 
-        warnings.warn(f"the geometry image of {name} stays {100 * distance['hausdorff']:.2g}% of the diagonal from the "
-                      f"mesh at n = {n}, the largest n='auto' tries (goal {100 * AUTO_HAUSDORFF:g}%): detail "
-                      "finer than the image resolves (fingers, thin ears) is smoothed away.", stacklevel=3)
+        warnings.warn(_distance_words(name, n, fairness, distance["hausdorff"], folds.get("fairness_tried", {})),
+                      stacklevel=3)
     stretch = dict(smap.stretch)
     stretch["flipped"] = int(smap.flipped)
     if sphere_map is None:
@@ -394,6 +396,27 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
     report = BuildReport(name, int(info["vertices"]), int(info["triangles"]), int(n), float(fairness), seconds,
                          stretch, distance, fit.rms, folded, got.orientation, tuple(repairs), folds)
     return fit.image, report
+
+
+def _distance_words(name, n, fairness, hausdorff, fairness_tried) -> str:
+    """The warning of an ``n="auto"`` image farther than :data:`AUTO_HAUSDORFF` from the mesh: what put it there,
+    the fairness kept against folds (its first weight's fit was within the goal) or the resolution.
+
+    >>> print(_distance_words("bent", 129, 3.0, 0.00501, {0.1: (4e-6, 0.0011), 3.0: (1e-6, 0.00501)}))
+    the geometry image of bent stays 0.5% of the diagonal from the mesh at n = 129 (goal 0.5%): fairness 3, kept against its folds, smooths it that far (at fairness 0.1: 0.11%).
+    """
+    words = f"the geometry image of {name} stays {100 * hausdorff:.2g}% of the diagonal from the mesh at n = {n} " \
+            f"(goal {100 * AUTO_HAUSDORFF:g}%): "
+    first = fairness_tried.get(AUTO_FAIRNESS[0])
+    if fairness != AUTO_FAIRNESS[0] and first is not None and first[1] <= AUTO_HAUSDORFF:
+        return words + (f"fairness {fairness:g}, kept against its folds, smooths it that far (at fairness "
+                        f"{AUTO_FAIRNESS[0]:g}: {100 * first[1]:.2g}%).")
+    return words + "detail finer than the image resolves (fingers, thin ears) is smoothed away."
+
+
+def _escalation_entry(built) -> tuple:
+    """(folds, inside out, Hausdorff distance) of one image of the escalation (``folds["escalation_tried"]``)."""
+    return built.folds["fraction"], built.folds["reversed"], float(built.distance["hausdorff"])
 
 
 def _parametrize(mesh, name, progress, options, seconds):
