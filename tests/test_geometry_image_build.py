@@ -149,28 +149,12 @@ def test_auto_size_builds_again_finer_from_a_nearer_conformal_map_where_the_imag
                in str(w.message) for w in caught)
 
 
-def test_a_tutte_started_map_is_reused_for_the_finer_image(monkeypatch):
-    # The inverse weight acts on the coarse-to-fine levels only: the blob's own start (Tutte) would come out the
-    # same with it, so the finer image is built from the same map (measured 0.16 % / 2.5 % at 17 -> 0.024 % / 0.16 %
-    # at 33) and labelled with the weight it had, 0; it equals the 33 x 33 image of that map.
-    import splinevis.geometry_image.build as build
-
-    monkeypatch.setattr(build, "AUTO_SIZES", (9, 17))
-    monkeypatch.setattr(build, "ESCALATE_MAX", 33)
-    mesh = cm.legged_blob(level=3)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        image, report = geometry_image_from_mesh(mesh, name="legs")
-        direct, _ = geometry_image_from_mesh(mesh, 33, name="legs")
-    assert list(report.folds["escalation_tried"]) == ["n = 17, level_inverse 0", "n = 33, level_inverse 0"]
-    assert report.n == 33 and report.stretch["level_inverse"] == 0.0
-    np.testing.assert_array_equal(image.control, direct.control)
-
-
-def test_the_escalation_doubles_the_size_while_the_last_image_still_folds(monkeypatch):
+def test_the_escalation_doubles_the_size_while_the_last_image_still_folds_reusing_a_tutte_map(monkeypatch):
     # The Tutte-started legged blob (level 3) with the sizes scaled down (5, 9, then at most 33): its 9 x 9 image
     # folds, and so does the 17 x 17 one (measured 0.16 % / 2.5 %), so the build goes on to 33 x 33 (0.024 % /
-    # 0.16 %): every image tried is listed, the least past the thresholds is kept, and it is exactly the image
+    # 0.16 %): every image tried is listed, the least past the thresholds is kept. The inverse weight acts on the
+    # coarse-to-fine levels only: a Tutte start would come out the same with it, so the finer images are built
+    # from the same map, labelled with the weight it had, 0, and the kept one is exactly the image of that size
     # asked for directly.
     import splinevis.geometry_image.build as build
 
@@ -188,6 +172,7 @@ def test_the_escalation_doubles_the_size_while_the_last_image_still_folds(monkey
     assert list(report.distance["sizes_tried"])[-2:] == [17, 33]
     kept = f"n = {report.n}, level_inverse 0"
     assert tried[kept] == (report.folds["fraction"], report.folds["reversed"], report.distance["hausdorff"])
+    assert report.stretch["level_inverse"] == 0.0
     np.testing.assert_array_equal(image.control, direct.control)
 
 
