@@ -27,13 +27,16 @@ def test_the_depth_bound_at_the_reference_hits_equals_the_one_cast_again():
     hits = raycast.reference(model, o, d)
     h = np.flatnonzero(hits.hit)
     assert h.size > 300
+    state = raycast._LAST.state
+    # a ray the last cast did not shoot is not found (and gets the bound of a new cast); a lookup forgets the cast
+    pid, _ = raycast._LAST.find(model, o[h[:5]] + 1e-3, d[h[:5]], hits.t[h[:5]])
+    assert (pid == -1).all() and raycast._LAST.state is None
+    raycast._LAST.state = state
     pid, uv = raycast._LAST.find(model, o[h], d[h], hits.t[h])
     assert (pid == 0).all() and np.isfinite(uv).all()  # every hit found again
-    # a ray the last cast did not shoot is not found (and gets the bound of a new cast)
-    pid, _ = raycast._LAST.find(model, o[h[:5]] + 1e-3, d[h[:5]], hits.t[h[:5]])
-    assert (pid == -1).all()
+    raycast._LAST.state = state
     kept = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h])
-    raycast._LAST.model = None  # forget the cast: the bound casts again from just before each hit
+    assert raycast._LAST.state is None  # forgotten: the bound below casts again from just before each hit
     again = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h])
     # both (u, v) are Newton's fixed points of the same root (to 4 eps of the parameters); the bound is smooth in
     # S_u, S_v and the normal there, so the two agree far below the bound's own size (hundreds of u32)

@@ -251,10 +251,11 @@ def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
 class _LastHits:
     """The patch and (u, v) of each hit of the last reference cast, found again by the ray's exact origin,
     direction and t: :func:`depth_bound` needs them at the hits the reference just found (the comparison of a
-    render with the reference calls both on the same rays), and casting again cost as much as the cast."""
+    render with the reference calls both on the same rays), and casting again cost as much as the cast. Kept as
+    one tuple (a thread reads all of one cast or none) until the first lookup, which frees it."""
 
     def __init__(self):
-        self.model, self.index, self.pid, self.uv = None, {}, None, None
+        self.state = None  # (weak reference to the model, {ray key: row}, pid, uv)
 
     @staticmethod
     def _keys(o, d, t):
@@ -264,21 +265,22 @@ class _LastHits:
     def store(self, model, o, d, t, pid, uv):
         hit = np.flatnonzero(np.isfinite(t))
         try:
-            self.model = weakref.ref(model)
+            ref = weakref.ref(model)
         except TypeError:  # not weakly referable: nothing is kept
-            self.model = None
+            self.state = None
             return
-        self.index = dict(zip(self._keys(o[hit], d[hit], t[hit]), hit))
-        self.pid, self.uv = pid, uv
+        self.state = (ref, dict(zip(self._keys(o[hit], d[hit], t[hit]), hit)), pid, uv)
 
     def find(self, model, o, d, t):
-        """(pid, uv) of every ray found in the last cast of ``model`` (pid -1 where not found)."""
+        """(pid, uv) of every ray found in the last cast of ``model`` (pid -1 where not found); forgets the cast."""
         pid, uv = np.full(len(o), -1), np.full((len(o), 2), np.nan)
-        if self.model is None or self.model() is not model or not len(o):
+        state, self.state = self.state, None
+        if state is None or state[0]() is not model or not len(o):
             return pid, uv
-        at = np.array([self.index.get(k, -1) for k in self._keys(o, d, t)], dtype=np.int64)
+        _, index, pid_cast, uv_cast = state
+        at = np.array([index.get(k, -1) for k in self._keys(o, d, t)], dtype=np.int64)
         found = at >= 0
-        pid[found], uv[found] = self.pid[at[found]], self.uv[at[found]]
+        pid[found], uv[found] = pid_cast[at[found]], uv_cast[at[found]]
         return pid, uv
 
 
