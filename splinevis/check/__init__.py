@@ -38,13 +38,13 @@ from .detect import collect_files, companion_files, detect_family
 
 __all__ = ["check", "FILE_TIMEOUT", "FILE_TIMEOUT_DEFAULT"]
 
-#: Seconds one file of a family may take before it is judged FAIL (a reader that never returns): about ten times
-#: the family's slowest file in the whole data folder's check (CI's ``.ci/run``, two files at once on two cores), at least 600:
-#: NURBS 87 s, volumes 54 s, terrains 13 s. Meshes 1800: a scan whose geometry image folds is built twice, the
+#: Seconds one file of a family may take before it is judged FAIL (a reader that never returns): about ten times the
+#: family's slowest file in the whole data folder's check (CI's ``.ci/run``, two files at once on two cores), at least
+#: 600: NURBS 87 s, volumes 54 s, terrains 13 s. Meshes 1800: a scan whose geometry image folds is built twice, the
 #: second time at 513 x 513 (``geometry_image.auto.ESCALATE_INVERSE``), and measured on the 134 million limit
-#: triangles of that image's level 4: armadillo.obj took 929 s with beast.obj judged beside it (build 635 s,
-#: measures 280 s; beast.obj 877 s), and 1177 s in the whole folder's check (with another measurement running on
-#: the same two cores).
+#: triangles of that image's level 4: armadillo.obj took 929 s with beast.obj judged beside it (build 635 s, measures
+#: 280 s; beast.obj 877 s), and 1177 s in the whole folder's check (with another measurement running on the same two
+#: cores).
 FILE_TIMEOUT = {"mesh": 1800.0, "nurbs": 900.0, "volume": 600.0, "terrain": 600.0}
 #: A family not in :data:`FILE_TIMEOUT`.
 FILE_TIMEOUT_DEFAULT = 900.0

@@ -54,25 +54,25 @@ AUTO_HAUSDORFF = 0.005
 AUTO_FAIRNESS = (0.1, 0.3, 1.0, 3.0)
 AUTO_FAIRNESS_HAUSDORFF = 0.01
 
-#: What ``n="auto"`` does when the image it chose still folds or is inside out (:func:`_badness` above 1) after
-#: the turn guard and fairness were tried: it parametrizes the mesh again with the inverse map's stretch in the
-#: coarse levels' relaxations (``level_inverse`` = :data:`ESCALATE_INVERSE`, :data:`.hierarchy.LEVEL_INVERSE`'s
-#: comment says why that keeps the coarse levels nearer conformal) and builds an image twice as fine, and again while the last one built still
-#: folds (at most :data:`ESCALATE_MAX` samples per side; a map from the Tutte start, which the weight does not
-#: change, is reused for it); an image less past the thresholds than the one kept so far replaces it, if it is no
+#: What ``n="auto"`` does when the image it chose still folds or is inside out (:func:`_badness` above 1) after the
+#: turn guard and fairness were tried: it parametrizes the mesh again with the inverse map's stretch in the coarse
+#: levels' relaxations (``level_inverse`` = :data:`ESCALATE_INVERSE`, :data:`.hierarchy.LEVEL_INVERSE`'s comment says
+#: why that keeps the coarse levels nearer conformal) and builds an image twice as fine, and again while the last one
+#: built still folds (at most :data:`ESCALATE_MAX` samples per side; a map from the Tutte start, which the weight does
+#: not change, is reused for it); an image less past the thresholds than the one kept so far replaces it, if it is no
 #: farther from the mesh than ``max(AUTO_FAIRNESS_HAUSDORFF, that one's distance)`` (:func:`_prefer`; ``folds[
-#: "escalation_tried"]`` has every image tried). The bent blob (5,120 triangles) went 65 -> 129 (0.0103 % folds)
-#: -> 257 (0.0071 %, 0.15 % of the diagonal): one doubling had kept the 129 image, just past the threshold. Why both at once: at n = 257 the thin limbs of the four-legged scan cannot be
-#: sampled evenly and densely at once. Measured (folds at level 4 / inside out / Hausdorff, what the build kept):
-#: beast.obj 0.34 % / 2.5 % / 0.72 % at 257; level_inverse 1 alone 0.038 % / 0.71 % / 0.91 %; n = 513 alone
-#: 0.16 % / 0.48 % / 0.89 %; both (this build, measured by ``splinevis check``) 0.0146 % / 0.155 % / 0.46 %.
-#: armadillo.obj 0.118 % / 0.34 % / 0.93 % at 257; level_inverse 1 alone 0.118 % / 0.47 % / 0.91 %; both
-#: 0.0343 % / 0.063 % / 0.46 %. It costs a second parametrization and an image four times as large: the builds
-#: took 406 s (armadillo, alone) and 495 s (beast, beside another) instead of about 100 s. A mesh whose image
-#: does not fold never pays it. What was tried beyond it (docs/geometry_images.md has the figures): per-vertex
-#: sweeps on the escalation's map (nearer conformal, more folds), fairness raised on the folded cells only (fewer
-#: folds, more inside out). What stops the beast's 513 image is its inside-out share: fairness 3 takes its folds
-#: under the threshold (0.0059 %) but not that (0.17 %), flaps in the concave creases.
+#: "escalation_tried"]`` has every image tried). The bent blob (5,120 triangles) went 65 -> 129 (0.0103 % folds) ->
+#: 257 (0.0071 %, 0.15 % of the diagonal): one doubling had kept the 129 image, just past the threshold. Why both at
+#: once: at n = 257 the thin limbs of the four-legged scan cannot be sampled evenly and densely at once. Measured
+#: (folds at level 4 / inside out / Hausdorff, what the build kept): beast.obj 0.34 % / 2.5 % / 0.72 % at 257;
+#: level_inverse 1 alone 0.038 % / 0.71 % / 0.91 %; n = 513 alone 0.16 % / 0.48 % / 0.89 %; both (this build, measured
+#: by ``splinevis check``) 0.0146 % / 0.155 % / 0.46 %. armadillo.obj 0.118 % / 0.34 % / 0.93 % at 257; level_inverse
+#: 1 alone 0.118 % / 0.47 % / 0.91 %; both 0.0343 % / 0.063 % / 0.46 %. It costs a second parametrization and an image
+#: four times as large: the builds took 406 s (armadillo, alone) and 495 s (beast, beside another) instead of about
+#: 100 s. A mesh whose image does not fold never pays it. What was tried beyond it (docs/geometry_images.md has the
+#: figures): per-vertex sweeps on the escalation's map (nearer conformal, more folds), fairness raised on the folded
+#: cells only (fewer folds, more inside out). What stops the beast's 513 image is its inside-out share: fairness 3
+#: takes its folds under the threshold (0.0059 %) but not that (0.17 %), flaps in the concave creases.
 ESCALATE_INVERSE = 1.0
 ESCALATE_MAX = 513
 

@@ -231,8 +231,9 @@ def geometry_image_from_mesh(mesh, n="auto", *, fairness="auto", oversample="aut
         the first of :data:`AUTO_SIZES` whose limit surface is within :data:`AUTO_HAUSDORFF` of the diagonal of
         the mesh (measured; ``distance["sizes_tried"]`` lists each size's distance), with a warning when the
         largest is not; an image that still folds is built again, twice as fine (and again while the last one
-        still folds, up to :data:`ESCALATE_MAX`), from a parametrization nearer conformal (:data:`ESCALATE_INVERSE`; from the same map where it came from the Tutte start, which the weight
-        does not change; not when ``sphere_map`` or ``parametrization_options["level_inverse"]`` is given).
+        still folds, up to :data:`ESCALATE_MAX`), from a parametrization nearer conformal
+        (:data:`ESCALATE_INVERSE`; from the same map where it came from the Tutte start, which the weight does
+        not change; not when ``sphere_map`` or ``parametrization_options["level_inverse"]`` is given).
     fairness : float or "auto"
         The fit's fairness weight (:func:`.fit.fit_geometry_image`): 0.1 suppresses the ripples a faceted input
         leaves in the normals (measured in the geometry-image study) at a small cost in distance. ``"auto"``
