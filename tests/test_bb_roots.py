@@ -250,3 +250,30 @@ def test_bracketed_never_misses_well_conditioned_first_roots_1e5_quartics():
     print(f"well-conditioned first roots: {well}; paper method missed {paper['missed'].sum()}, "
           f"later root {paper['later'].sum()}; bracketed missed 0, wrong 0")
     assert paper_bad > 0.05 * well
+
+
+def _de_casteljau_op_by_op(c, x, dtype):
+    """glsl/lib/core/bernstein.glsl's sv_bernstein_eval_deriv written out: a new value per operation."""
+    n = c.shape[-1] - 1
+    s = dtype(1.0) - x
+    b = [c[..., k] for k in range(n + 1)]
+    for level in range(1, n):
+        for k in range(n - level + 1):
+            b[k] = s * b[k] + x * b[k + 1]
+    return s * b[0] + x * b[1], dtype(n) * (b[1] - b[0])
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_evaluation_into_buffers_is_the_shaders_arithmetic_bit_for_bit(n, dtype):
+    # the twin evaluates into buffers allocated once (the terrain walk's scans are millions of values); the values
+    # must stay those of the shader's sequence of float operations, in float32 as in float64, for every broadcast
+    rng = np.random.default_rng(n)
+    for c_shape, x_shape in [((n + 1,), ()), ((n + 1,), (9,)), ((7, 1, n + 1), (7, 3)), ((7, n + 1), (7,)),
+                             ((7, n + 1), ()), ((1, n + 1), (4,))]:
+        c = (rng.normal(size=c_shape) * 10.0 ** rng.integers(-8, 8, c_shape)).astype(dtype)
+        for x in [rng.random(x_shape).astype(dtype)] + ([0.3] if x_shape == () else []):
+            got, want = eval_deriv(c, x, dtype=dtype), _de_casteljau_op_by_op(c, x, dtype)
+            for g, w in zip(got, want):
+                assert g.dtype == np.asarray(w).dtype and g.shape == np.shape(w)
+                np.testing.assert_array_equal(g, w)
