@@ -146,8 +146,9 @@ def raycast_error_px(model, view, level, cache, *, rays=(32, 24)):
     ok = np.isfinite(t)
     if not ok.any():
         return SNAP_PX, False
+    surface = hits.surface_at(ok)  # the family's parameters of the hits (its bound need not find them again)
     o, d, t = o[ok], d[ok], t[ok]
-    bound = np.asarray(program.depth_bound(model, m, o, d, t), dtype=np.float64)
+    bound = np.asarray(program.depth_bound(model, m, o, d, t, surface=surface), dtype=np.float64)
     h = 1e-6 * np.maximum(1.0, np.abs(t))
     # the bound is |d depth / dt| dt + the depth arithmetic and quantization (depth_error with dt = 0), which
     # move no point (a mesh's depth has them too): keep the part that moves the hit along its ray

@@ -1,5 +1,5 @@
-"""The NURBS float64 ray cast's bookkeeping: the depth bound at the hits the reference just found uses that
-cast's patch and (u, v) instead of casting again, with the same result."""
+"""The NURBS float64 ray cast hands its hits' patch and (u, v) on (RayHits.surface): the depth bound at the hits the
+reference found uses them instead of casting again, with the same result."""
 
 import numpy as np
 
@@ -23,21 +23,23 @@ def test_the_depth_bound_at_the_reference_hits_equals_the_one_cast_again():
     model = NurbsModel([torus()])
     matrix = _camera_matrix()
     o, d = pixel_rays(matrix, 64, 48)
-    o, d = o.reshape(-1, 3), d.reshape(-1, 3)
-    hits = raycast.reference(model, o, d)
-    h = np.flatnonzero(hits.hit)
-    assert h.size > 300
-    state = raycast._LAST.state
-    # a ray the last cast did not shoot is not found (and gets the bound of a new cast); a lookup forgets the cast
-    pid, _ = raycast._LAST.find(model, o[h[:5]] + 1e-3, d[h[:5]], hits.t[h[:5]])
-    assert (pid == -1).all() and raycast._LAST.state is None
-    raycast._LAST.state = state
-    pid, uv = raycast._LAST.find(model, o[h], d[h], hits.t[h])
-    assert (pid == 0).all() and np.isfinite(uv).all()  # every hit found again
-    raycast._LAST.state = state
-    kept = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h])
-    assert raycast._LAST.state is None  # forgotten: the bound below casts again from just before each hit
-    again = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h])
+    hits = raycast.reference(model, o, d)  # rays of shape (48, 64): the parameters keep the rays' shape
+    assert hits.surface["patch"].shape == (48, 64) and hits.surface["uv"].shape == (48, 64, 2)
+    h = hits.hit
+    assert h.sum() > 300
+    kept = hits.surface_at(h)
+    assert (kept["patch"] == 0).all() and np.isfinite(kept["uv"]).all()  # every hit on the one patch, (u, v) known
+    assert (hits.surface["patch"][~h] == -1).all()
+    # the surface point at the kept (u, v) is the hit point
+    S = model.surfaces[0].evaluate(kept["uv"][:, 0], kept["uv"][:, 1])
+    assert np.abs(S - hits.points[h]).max() < 1e-9
+    bound = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h], surface=kept)
+    again = raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h])  # no parameters: each ray cast again
     # both (u, v) are Newton's fixed points of the same root (to 4 eps of the parameters); the bound is smooth in
     # S_u, S_v and the normal there, so the two agree far below the bound's own size (hundreds of u32)
-    assert np.allclose(kept, again, rtol=1e-9, atol=0.0)
+    assert np.allclose(bound, again, rtol=1e-9, atol=0.0)
+    # a hit whose patch is not known (-1) is cast again, the others keep theirs: the same bound
+    partial = {"patch": kept["patch"].copy(), "uv": kept["uv"].copy()}
+    partial["patch"][::3] = -1
+    assert np.allclose(raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h], surface=partial), bound,
+                       rtol=1e-9, atol=0.0)

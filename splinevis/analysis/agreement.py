@@ -80,7 +80,8 @@ def depth_agreement(model, camera_position, window_size=(400, 300), *, newton_it
     gpu_hit = gpu < 1.0
     both = gpu_hit & ref_hit
     interior = ndimage.binary_erosion(ref_hit, structure=np.ones((3, 3)), border_value=0)
-    bound = program.depth_bound(model, matrix, o[both], d[both], hits.t[both]) + subpixel_depth_slack(ref)[both]
+    bound = program.depth_bound(model, matrix, o[both], d[both], hits.t[both], surface=hits.surface_at(both))
+    bound = bound + subpixel_depth_slack(ref)[both]
     return {
         "pixels": w * h,
         "hit_disagree": int((gpu_hit != ref_hit).sum()),

@@ -69,10 +69,12 @@ def patch_program(patch: QuarticTrianglePatch, style=None, *, newton_iterations:
     )
 
 
-def patch_depth_bound(patch: QuarticTrianglePatch, matrix, origins, directions, t) -> np.ndarray:
+def patch_depth_bound(patch: QuarticTrianglePatch, matrix, origins, directions, t, *,
+                      surface=None) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions``
     (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`). The shader's rays start on the far side of
-    the proxy (lib/core/raycast.glsl), so the coordinates it rounds are bounded by the proxy's extent.
+    the proxy (lib/core/raycast.glsl), so the coordinates it rounds are bounded by the proxy's extent. The bound
+    depends on the hits' positions only: ``surface`` (the contract's hit parameters) is not read.
 
     Examples
     --------

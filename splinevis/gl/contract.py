@@ -59,22 +59,40 @@ class RayHits:
         World normals at the hits, not necessarily unit (NaN on a miss).
     hit : (...) bool ndarray
         ``isfinite(t)``.
+    surface : dict or None
+        The family's own parameters of each hit (for example a NURBS model's ``patch`` and ``uv``), arrays whose
+        leading shape is that of ``t``; None where the family has none to give. Only the family that made them
+        reads them (its ``depth_bound`` takes them as ``surface``, so it need not find the hits again).
 
     Examples
     --------
     >>> import numpy as np
-    >>> h = RayHits(np.array([1.0, np.nan]), np.zeros((2, 3)), np.zeros((2, 3)))
-    >>> h.hit.tolist()
-    [True, False]
+    >>> h = RayHits(np.array([1.0, np.nan]), np.zeros((2, 3)), np.zeros((2, 3)), {"patch": np.array([4, -1])})
+    >>> h.hit.tolist(), h.surface_at(h.hit)["patch"].tolist()
+    ([True, False], [4])
     """
 
-    __slots__ = ("t", "points", "normals", "hit")
+    __slots__ = ("t", "points", "normals", "hit", "surface")
 
-    def __init__(self, t, points, normals):
+    def __init__(self, t, points, normals, surface=None):
         self.t = t
         self.points = points
         self.normals = normals
         self.hit = np.isfinite(t)
+        self.surface = surface
+
+    def surface_at(self, index):
+        """``surface`` of the rays ``index`` (any numpy index into ``t``, e.g. a mask of the hits one keeps), or
+        None.
+
+        >>> h = RayHits(np.array([[1.0, 2.0], [np.nan, 3.0]]), np.zeros((2, 2, 3)), np.zeros((2, 2, 3)),
+        ...             {"uv": np.arange(8.0).reshape(2, 2, 2)})
+        >>> h.surface_at(h.hit)["uv"].tolist(), RayHits(h.t, h.points, h.normals).surface_at(h.hit)
+        ([[0.0, 1.0], [2.0, 3.0], [6.0, 7.0]], None)
+        """
+        if self.surface is None:
+            return None
+        return {k: np.asarray(v)[index] for k, v in self.surface.items()}
 
     def __repr__(self):
         return f"RayHits(rays={self.t.size}, hits={int(self.hit.sum())})"
@@ -163,9 +181,10 @@ class SplineProgram:
         iterations=None) -> RayHits`` for world rays of any leading shape; ``method`` is ``"reference"``
         (robust: every root isolated) or one of ``root_methods`` (the GPU's method in float64).
     depth_bound : callable, optional
-        ``depth_bound(model, matrix, origins, directions, t) -> (n,) ndarray``: the derived bound on
-        |GPU window depth - float64 window depth| at hits ``origins + t directions`` (world, float64)
-        for the camera ``matrix`` (world -> NDC).
+        ``depth_bound(model, matrix, origins, directions, t, *, surface=None) -> (n,) ndarray``: the derived
+        bound on |GPU window depth - float64 window depth| at hits ``origins + t directions`` (world, float64)
+        for the camera ``matrix`` (world -> NDC); ``surface`` is :meth:`RayHits.surface_at` of the reference
+        cast that found those hits (None: the family finds what it needs from the rays).
     hard_cases : callable, optional
         ``hard_cases() -> list of HardCase``.
     model_from : callable, optional
@@ -300,7 +319,8 @@ class SplineProgram:
         problems = []
         checks = [("build", self.build, ("model", "style"), ("newton_iterations",)),
                   ("reference", self.reference, ("model", "origins", "directions", "tmin"), ("method", "iterations")),
-                  ("depth_bound", self.depth_bound, ("model", "matrix", "origins", "directions", "t"), ())]
+                  ("depth_bound", self.depth_bound, ("model", "matrix", "origins", "directions", "t"),
+                   ("surface",))]
         for label, fn, positional, keywords in checks:
             if fn is None:
                 continue

@@ -12,8 +12,6 @@ interpolated parameters by Newton on the pixel's ray written as two planes [Kana
 
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from ..gl.contract import RayHits
@@ -248,45 +246,6 @@ def _cast(model, origins, directions, tmin, iterations, subdivisions, gpu):
     return t_out, pid_out, uv_out
 
 
-class _LastHits:
-    """The patch and (u, v) of each hit of the last reference cast, found again by the ray's exact origin,
-    direction and t: :func:`depth_bound` needs them at the hits the reference just found (the comparison of a
-    render with the reference calls both on the same rays), and casting again cost as much as the cast. Kept as
-    one tuple (a thread reads all of one cast or none) until the first lookup, which frees it."""
-
-    def __init__(self):
-        self.state = None  # (weak reference to the model, {ray key: row}, pid, uv)
-
-    @staticmethod
-    def _keys(o, d, t):
-        rows = np.ascontiguousarray(np.concatenate([o, d, t[:, None]], axis=1))
-        return [r.tobytes() for r in rows]
-
-    def store(self, model, o, d, t, pid, uv):
-        hit = np.flatnonzero(np.isfinite(t))
-        try:
-            ref = weakref.ref(model)
-        except TypeError:  # not weakly referable: nothing is kept
-            self.state = None
-            return
-        self.state = (ref, dict(zip(self._keys(o[hit], d[hit], t[hit]), hit)), pid, uv)
-
-    def find(self, model, o, d, t):
-        """(pid, uv) of every ray found in the last cast of ``model`` (pid -1 where not found); forgets the cast."""
-        pid, uv = np.full(len(o), -1), np.full((len(o), 2), np.nan)
-        state, self.state = self.state, None
-        if state is None or state[0]() is not model or not len(o):
-            return pid, uv
-        _, index, pid_cast, uv_cast = state
-        at = np.array([index.get(k, -1) for k in self._keys(o, d, t)], dtype=np.int64)
-        found = at >= 0
-        pid[found], uv[found] = pid_cast[at[found]], uv_cast[at[found]]
-        return pid, uv
-
-
-_LAST = _LastHits()
-
-
 def reference(model, origins, directions, tmin=0.0, *, method="reference", iterations=None):
     """Float64 ray cast of a NURBS model (world rays of any leading shape): :class:`RayHits`.
 
@@ -308,7 +267,6 @@ def reference(model, origins, directions, tmin=0.0, *, method="reference", itera
     shape = o.shape[:-1]
     if method == "reference":
         t, pid, uv = _cast(m, o, d, tmin, 40, 8, False)
-        _LAST.store(model, o.reshape(-1, 3), d.reshape(-1, 3), t, pid, uv)
     elif method == "newton":
         t, pid, uv = _cast(m, o, d, tmin, 12 if iterations is None else iterations, 8, True)
     else:
@@ -320,7 +278,9 @@ def reference(model, origins, directions, tmin=0.0, *, method="reference", itera
         sel = np.flatnonzero(pid == k)
         if sel.size:
             normals[sel] = s.normal(uv[sel, 0], uv[sel, 1])
-    return RayHits(t.reshape(shape), points.reshape(shape + (3,)), normals.reshape(shape + (3,)))
+    # each hit's patch and (u, v): what depth_bound needs at the hits (RayHits.surface), so it need not cast again
+    surface = {"patch": pid.reshape(shape), "uv": uv.reshape(shape + (2,))}
+    return RayHits(t.reshape(shape), points.reshape(shape + (3,)), normals.reshape(shape + (3,)), surface)
 
 
 def residual_tolerance(surface, facts, Su, Sv, ray_origin_size):
@@ -348,8 +308,10 @@ def _eps_s(surface, facts, Su, Sv):
     return (6 * (p + q) + 8) * U32 * facts["magnitude"] + U32 * facts["knot_max"] * size
 
 
-def depth_bound(model, matrix, origins, directions, t):
-    """Per-pixel bound on |GPU window depth - float64 window depth| at hits ``origins + t directions``.
+def depth_bound(model, matrix, origins, directions, t, *, surface=None):
+    """Per-pixel bound on |GPU window depth - float64 window depth| at hits ``origins + t directions``; ``surface``:
+    the hits' ``patch`` and ``uv`` (:meth:`~splinevis.gl.contract.RayHits.surface_at` of the :func:`reference` cast
+    that found them; without it, or where a patch is -1, each ray is cast again from just before its hit).
 
     Derivation (float32, u = 2^-24): the GPU accepts S(u, v) when the residual |F| (the distance of S from the
     ray, measured in the two planes) is below tol (:func:`residual_tolerance`); S itself is off by eps_S and the
@@ -377,7 +339,11 @@ def depth_bound(model, matrix, origins, directions, t):
     t = np.asarray(t, dtype=np.float64).ravel()
     # the patch and (u, v) of each hit: those of the reference cast that found it, else cast again from just
     # before the hit (the first root after that start is the hit)
-    pid, uv = _LAST.find(model, o, d, t)
+    if surface is not None:
+        pid = np.array(surface["patch"], dtype=np.int64).reshape(-1)
+        uv = np.array(surface["uv"], dtype=np.float64).reshape(-1, 2)
+    else:
+        pid, uv = np.full(len(o), -1, dtype=np.int64), np.full((len(o), 2), np.nan)
     again = np.flatnonzero(pid < 0)
     if again.size:
         oa, da, ta = o[again], d[again], t[again]

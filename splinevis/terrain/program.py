@@ -259,10 +259,12 @@ def terrain_program(terrain: TerrainSpline, style=None, *, newton_iterations: in
     )
 
 
-def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t) -> np.ndarray:
+def terrain_depth_bound(terrain: TerrainSpline, matrix, origins, directions, t, *,
+                        surface=None) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions`` (world): the shader
     works in the model frame (world - offset) and in index coordinates, so the rounded coordinates are
-    bounded by the terrain's extent (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`).
+    bounded by the terrain's extent (:func:`splinevis.gl.error_bounds.ray_depth_error_bound`). The bound depends on
+    the hits' positions only: ``surface`` (the contract's hit parameters) is not read.
 
     Examples
     --------

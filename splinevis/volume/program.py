@@ -221,9 +221,11 @@ def set_isovalue(actor, isovalue: float) -> Relevant:
     return rel
 
 
-def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t) -> np.ndarray:
+def isosurface_depth_bound(model: Isosurface, matrix, origins, directions, t, *,
+                           surface=None) -> np.ndarray:
     """Derived bound on |GPU - float64| window depth at hits ``origins + t directions`` (world), from
-    :func:`splinevis.gl.error_bounds.isosurface_depth_error_bound` in the model frame.
+    :func:`splinevis.gl.error_bounds.isosurface_depth_error_bound` in the model frame. The bound depends on the hits'
+    positions only: ``surface`` (the contract's hit parameters) is not read.
 
     Examples
     --------

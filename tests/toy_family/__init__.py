@@ -58,7 +58,7 @@ def reference(model, origins, directions, tmin=0.0, *, method="reference", itera
     return RayHits(t, p, p - model.center)
 
 
-def depth_bound(model, matrix, origins, directions, t):
+def depth_bound(model, matrix, origins, directions, t, *, surface=None):
     # g(t) = |ro + t rd|^2 - r^2 in float32 from a proxy point ro (|ro| <= sqrt(3) r) with |rd| = 1: the dot
     # products and the square root round a few times on terms of size (|ro| + |t|)^2 <= (2 sqrt(3) r)^2, and
     # the ray itself is rounded (8 u P sideways over P = 2 sqrt(3) r, moving g by 2 |p| 8 u P):
