@@ -100,3 +100,18 @@ def test_the_reference_solves_in_batches_the_same_hits_as_step_by_step(kind, mon
     assert np.isfinite(batched.t).sum() > 500
     assert np.array_equal(batched.t, single.t, equal_nan=True)
     assert np.array_equal(batched.normals, single.normals, equal_nan=True)
+
+
+def test_each_ray_hits_what_it_hits_cast_alone():
+    # the walk keeps only the walking rays' rows (dropping stopped ones now and then) and solves the candidates of
+    # many rays at once: neither may change a ray's float operations, so a ray cast alone gets the same bits
+    t = TerrainSpline.from_heights(high_relief("cliff", 33), "C2", spacing=(1.0, 1.0))
+    o, d = _rays(t, 4000, 5)
+    d[::4, 2] = np.abs(d[::4, 2])  # a quarter turned up from where they enter the box: misses among the hits
+    together = raycast_terrain(t, o, d)
+    picked = np.random.default_rng(2).choice(len(o), 60, replace=False)
+    assert np.isfinite(together.t[picked]).sum() > 20 and np.isnan(together.t[picked]).sum() > 0
+    for k in picked:
+        alone = raycast_terrain(t, o[k], d[k])
+        assert np.array_equal(alone.t, together.t[k], equal_nan=True)
+        assert np.array_equal(alone.normals, together.normals[k], equal_nan=True)

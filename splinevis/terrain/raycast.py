@@ -53,6 +53,41 @@ def first_hit_in_cell(coef_cell, lu0, lv0, z0, du, dv, dz, ta, tb, *, method="re
     return np.where(np.isnan(t0) | (t1 < t0), t1, t0)  # the nearer hit; NaN only where both miss
 
 
+class _Batch:
+    """The candidate segments (ray, cell, ta, tb) of several walk steps, solved at once: the root finder's cost is
+    numpy's per-call overhead on the few hundred rows one step has. A ray walks on after its candidates until the
+    batch is solved (at most :data:`FLUSH_STEPS` steps or :data:`FLUSH_ROWS` rows), then stops at its first
+    candidate with a root, in the walk's order: the hits are those of solving every step apart, bit for bit.
+    :meth:`solve` writes ``t_hit`` and clears ``active`` of the rays that hit."""
+
+    def __init__(self, terrain, U0, V0, Z0, dU, dV, dZ, t_hit, active, *, method, iterations):
+        self.terrain, self.ray = terrain, (U0, V0, Z0, dU, dV, dZ)
+        self.t_hit, self.active = t_hit, active
+        self.options = {"method": method, "iterations": iterations}
+        self.pending, self.rows, self.steps = [], 0, 0
+
+    def add(self, rays, i, j, ta, tb):
+        self.pending.append((rays, i, j, ta, tb))
+        self.rows += len(rays)
+
+    def due(self) -> bool:
+        """One more walk step taken: is the batch to be solved now?"""
+        self.steps += 1
+        return bool(self.pending) and (self.rows >= FLUSH_ROWS or self.steps >= FLUSH_STEPS)
+
+    def solve(self):
+        if self.pending:
+            rays, ii, jj, ta, tb = (np.concatenate(a) for a in zip(*self.pending))
+            U0, V0, Z0, dU, dV, dZ = self.ray
+            th = first_hit_in_cell(self.terrain.coefficients[jj, ii], U0[rays] - ii, V0[rays] - jj, Z0[rays],
+                                   dU[rays], dV[rays], dZ[rays], ta, tb, **self.options)
+            found = np.nonzero(np.isfinite(th))[0]
+            first = found[np.unique(rays[found], return_index=True)[1]]  # each ray's earliest candidate with a root
+            self.t_hit[rays[first]] = th[first]
+            self.active[rays[first]] = False
+        self.pending, self.rows, self.steps = [], 0, 0
+
+
 def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, method: str = "reference",
                     iterations: int = 8, max_steps: int | None = None) -> RayHits:
     """Intersect rays (world coordinates, float64) with ``terrain``; the first hit of each ray.
@@ -113,64 +148,52 @@ def raycast_terrain(terrain: TerrainSpline, origins, directions, tmin=0.0, *, me
             t1 = np.where(flat, t1, np.minimum(t1, np.maximum(ta, tb)))
     active = t0 <= t1
     t_hit = np.full(n, np.nan)
-    # DDA state
-    tm = np.where(active, t0, 0.0)
-    uu, vv = U0 + tm * dU, V0 + tm * dV
-    ci = np.clip(np.floor(uu).astype(np.int64), 0, ncx - 1)
-    cj = np.clip(np.floor(vv).astype(np.int64), 0, ncy - 1)
-    step_i = np.where(dU > 0, 1, -1)
-    step_j = np.where(dV > 0, 1, -1)
+    batch = _Batch(terrain, U0, V0, Z0, dU, dV, dZ, t_hit, active, method=method, iterations=iterations)
     cell_lo, cell_hi = terrain.hierarchy.levels[0]
     steps = max_steps if max_steps is not None else 2 * (ncx + ncy) + 4
-    # The candidate segments (ray, cell, ta, tb) of several steps are solved in one batch: the root finder's
-    # cost is numpy's per-call overhead on the few hundred rows one step has. A ray walks on after its
-    # candidates until the batch is solved (at most FLUSH_STEPS steps), then stops at its first candidate with
-    # a root: in the walk's order, so the hits are those of solving every step at once, bit for bit.
-    pending = []  # per step: (rays, cells i, cells j, ta, tb)
-    pending_rows = 0
-    since_flush = 0
-
-    def flush():
-        rays, ii, jj, ta, tb = (np.concatenate(a) for a in zip(*pending))
-        th = first_hit_in_cell(terrain.coefficients[jj, ii], U0[rays] - ii, V0[rays] - jj, Z0[rays], dU[rays],
-                               dV[rays], dZ[rays], ta, tb, method=method, iterations=iterations)
-        found = np.nonzero(np.isfinite(th))[0]
-        first = found[np.unique(rays[found], return_index=True)[1]]  # each ray's earliest candidate with a root
-        t_hit[rays[first]] = th[first]
-        active[rays[first]] = False
-        pending.clear()
-
+    # The walking rays' state is kept compact (their rows only), so a step costs what its rays cost: rows of rays
+    # that stopped are dropped once they are a quarter of the rows (they walk on until then, marked dead: they add
+    # no candidate and their results are never read). Every ray does the same float operations as alone.
+    rays = np.nonzero(active)[0]
+    tm = t0[rays]
+    u0, v0, z0, du, dv, dz, t_end = (a[rays] for a in (U0, V0, Z0, dU, dV, dZ, t1))
+    ci = np.clip(np.floor(u0 + tm * du).astype(np.int64), 0, ncx - 1)
+    cj = np.clip(np.floor(v0 + tm * dv).astype(np.int64), 0, ncy - 1)
+    walking = np.ones(len(rays), dtype=bool)
     with np.errstate(divide="ignore", invalid="ignore"):
+        flat_u, flat_v = np.abs(du) < 1e-300, np.abs(dv) < 1e-300
+        step_i, step_j = np.where(du > 0, 1, -1), np.where(dv > 0, 1, -1)
         for _ in range(steps):
-            idx = np.nonzero(active)[0]
-            if len(idx) == 0:
+            if not walking.any():
                 break
-            i, j = ci[idx], cj[idx]
-            nbu = np.where(dU[idx] > 0, i + 1, i).astype(np.float64)
-            nbv = np.where(dV[idx] > 0, j + 1, j).astype(np.float64)
-            txu = np.where(np.abs(dU[idx]) < 1e-300, np.inf, (nbu - U0[idx]) / dU[idx])
-            txv = np.where(np.abs(dV[idx]) < 1e-300, np.inf, (nbv - V0[idx]) / dV[idx])
-            ta = tm[idx]
-            tb = np.minimum(np.minimum(txu, txv), t1[idx])
-            za, zb = Z0[idx] + ta * dZ[idx], Z0[idx] + tb * dZ[idx]
+            if 4 * int(np.count_nonzero(walking)) <= 3 * len(rays):  # compact
+                rays, tm, u0, v0, z0, du, dv, dz, t_end, ci, cj, flat_u, flat_v, step_i, step_j = (
+                    a[walking] for a in (rays, tm, u0, v0, z0, du, dv, dz, t_end, ci, cj, flat_u, flat_v, step_i,
+                                         step_j))
+                walking = np.ones(len(rays), dtype=bool)
+            nbu = np.where(du > 0, ci + 1, ci).astype(np.float64)
+            nbv = np.where(dv > 0, cj + 1, cj).astype(np.float64)
+            txu = np.where(flat_u, np.inf, (nbu - u0) / du)
+            txv = np.where(flat_v, np.inf, (nbv - v0) / dv)
+            ta = tm
+            tb = np.minimum(np.minimum(txu, txv), t_end)
+            za, zb = z0 + ta * dz, z0 + tb * dz
             rlo, rhi = np.minimum(za, zb), np.maximum(za, zb)
-            overlap = (rhi >= cell_lo[j, i]) & (rlo <= cell_hi[j, i])
+            overlap = walking & (rhi >= cell_lo[cj, ci]) & (rlo <= cell_hi[cj, ci])
             if overlap.any():
-                pending.append((idx[overlap], i[overlap], j[overlap], ta[overlap], tb[overlap]))
-                pending_rows += int(overlap.sum())
-            # advance every ray still walking
+                batch.add(rays[overlap], ci[overlap], cj[overlap], ta[overlap], tb[overlap])
+            # advance every ray (a dead one's cell is kept inside the grid, where its lookups stay valid)
             go_u = txu <= txv
-            tm[idx] = tb
-            ci[idx] += np.where(go_u, step_i[idx], 0)
-            cj[idx] += np.where(go_u, 0, step_j[idx])
-            done = (tb >= t1[idx]) | (ci[idx] < 0) | (ci[idx] >= ncx) | (cj[idx] < 0) | (cj[idx] >= ncy)
-            active[idx[done]] = False
-            since_flush += 1
-            if pending and (pending_rows >= FLUSH_ROWS or since_flush >= FLUSH_STEPS):
-                flush()
-                pending_rows = since_flush = 0
-        if pending:
-            flush()
+            tm = tb
+            ci = ci + np.where(go_u, step_i, 0)
+            cj = cj + np.where(go_u, 0, step_j)
+            out = (ci < 0) | (ci >= ncx) | (cj < 0) | (cj >= ncy)
+            walking &= ~((tb >= t_end) | out)
+            ci, cj = np.where(out, 0, ci), np.where(out, 0, cj)
+            if batch.due():
+                batch.solve()  # rays that found their hit stop walking
+                walking &= active[rays]
+        batch.solve()
     t = t_hit.reshape(shape)
     pts = o.reshape(shape + (3,)) + t[..., None] * d.reshape(shape + (3,))
     normals = np.full(pts.shape, np.nan)
