@@ -41,6 +41,7 @@ def test_folds_are_reported_and_warned():
     with pytest.warns(UserWarning, match="folds over in .* undersamples part of the mesh") as caught:
         _, report = geometry_image_from_mesh(cm.bent_blob(level=3), 33, name="bent blob", orientation=None)
     assert report.folded > FOLDED_WARNING and "bent blob" in str(caught[0].message)
+    assert "orientation=None" not in str(caught[0].message)  # the caller chose the rotation: not suggested
 
 
 @pytest.mark.parametrize("bad, check", [("torus_mesh", "genus 0"), ("open_cup", "manifold edges"),
@@ -147,6 +148,9 @@ def test_auto_size_builds_again_finer_from_a_nearer_conformal_map_where_the_imag
     assert "escalation_tried" not in report_direct.folds and report_direct.stretch["level_inverse"] == 1.0
     assert any("rebuilt from a parametrization nearer conformal (folds, inside out, distance: n = 17, level_inverse"
                in str(w.message) for w in caught)
+    # the rotation was chosen by the build: the warning names it as the other lever
+    assert any("rebuilt from" in str(w.message) and "orientation=None (the map's own)" in str(w.message)
+               for w in caught)
 
 
 def test_the_escalation_doubles_the_size_while_the_last_image_still_folds_reusing_a_tutte_map(monkeypatch):

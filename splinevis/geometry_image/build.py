@@ -384,7 +384,11 @@ def _build(mesh, n, fairness, oversample, name, measure, levels_finer, progress,
                              f"a stronger one moves the surface more than {100 * AUTO_FAIRNESS_HAUSDORFF:g}% of "
                              "the diagonal from the mesh)." if list(folds["fairness_tried"].values())[-1][1]
                              > AUTO_FAIRNESS_HAUSDORFF else "the fewest folds of the weights tried).")
-                         if auto_fairness else "a larger n or fairness reduces the ripples."), stacklevel=3)
+                         if auto_fairness else "a larger n or fairness reduces the ripples.")
+                      + (" The sphere's rotation under the octahedron decides where the folds fall as well: with "
+                         "orientation=None (the map's own) or another rotation matrix their share can change "
+                         "several-fold (4.5x and 15x between rotations on two scans, docs/geometry_images.md)."
+                         if isinstance(orientation, str) else ""), stacklevel=3)
     if measure and len(sizes) > 1 and distance["hausdorff"] > AUTO_HAUSDORFF:
         import warnings
 
