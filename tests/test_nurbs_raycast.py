@@ -2,6 +2,7 @@
 reference found uses them instead of casting again, with the same result."""
 
 import numpy as np
+import pytest
 
 from splinevis.gl.camera import pixel_rays
 from splinevis.nurbs import raycast
@@ -43,3 +44,6 @@ def test_the_depth_bound_at_the_reference_hits_equals_the_one_cast_again():
     partial["patch"][::3] = -1
     assert np.allclose(raycast.depth_bound(model, matrix, o[h], d[h], hits.t[h], surface=partial), bound,
                        rtol=1e-9, atol=0.0)
+    # parameters of other rays than the ones asked about: refused, not silently paired with the wrong rays
+    with pytest.raises(ValueError, match="surface has .* for .* rays"):
+        raycast.depth_bound(model, matrix, o[h][:-1], d[h][:-1], hits.t[h][:-1], surface=kept)

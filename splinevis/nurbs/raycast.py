@@ -342,6 +342,9 @@ def depth_bound(model, matrix, origins, directions, t, *, surface=None):
     if surface is not None:
         pid = np.array(surface["patch"], dtype=np.int64).reshape(-1)
         uv = np.array(surface["uv"], dtype=np.float64).reshape(-1, 2)
+        if len(pid) != len(o) or len(uv) != len(o):
+            raise ValueError(f"surface has {len(pid)} patches and {len(uv)} (u, v) for {len(o)} rays: pass "
+                             "RayHits.surface_at of the same rays as origins, directions and t.")
     else:
         pid, uv = np.full(len(o), -1, dtype=np.int64), np.full((len(o), 2), np.nan)
     again = np.flatnonzero(pid < 0)
